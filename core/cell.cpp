@@ -1,0 +1,1 @@
+// Placeholder translation unit so that febemesh_core links before the tree lands.
