@@ -1,0 +1,162 @@
+#pragma once
+// A bounding-volume hierarchy over the triangles of a surface: the spatial index behind every
+// boundary query (closest point, local minima of the distance, segment crossing, box overlap,
+// ray parity). A flat array of nodes, children adjacent, leaves of at most 4 triangles, split
+// at the median centroid along the longest axis (deterministic: ties broken by index).
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "core/box.hpp"
+#include "dim3/surface.hpp"
+#include "dim3/triangle_predicates.hpp"
+
+namespace febemesh::dim3 {
+
+/// Sixteen fixed unit directions for ray parity (pseudo-random from a fixed seed, so that rays
+/// are unlikely to run along the axis-aligned structure of CAD parts, yet every run is the same).
+const std::array<P3, 16>& ray_directions();
+
+class AabbTree {
+ public:
+  struct Closest {
+    std::int32_t triangle = -1;
+    TrianglePoint where;
+    double distance2 = std::numeric_limits<double>::infinity();
+  };
+
+  AabbTree() = default;
+  AabbTree(const std::vector<P3>& vertices, const std::vector<Triangle>& triangles);
+
+  int n_triangles() const { return static_cast<int>(ids_.size()); }
+  int n_nodes() const { return static_cast<int>(nodes_.size()); }
+  Box<3> bounds() const { return nodes_.empty() ? Box<3>::empty() : nodes_[0].box; }
+  /// Corner coordinates of triangle t (by its surface index).
+  const std::array<P3, 3>& points(std::int32_t t) const { return points_[slot_[t]]; }
+
+  /// Closest point of the surface to p; ties go to the first triangle met (deterministic).
+  Closest closest(const P3& p) const;
+  /// Closest point over triangles with skip(t) false.
+  template <class Skip> Closest closest_if(const P3& p, Skip&& skip) const;
+
+  /// Calls f(t) for every triangle whose box is within `radius` of p (a superset of the
+  /// triangles within `radius`), in tree order.
+  template <class F> void for_each_near(const P3& p, double radius, F&& f) const;
+  /// Calls f(t) for every triangle whose box meets `box`.
+  template <class F> void for_each_in_box(const Box<3>& box, F&& f) const;
+  /// Calls f(t) for every triangle whose box meets the segment [a, b].
+  template <class F> void for_each_on_segment(const P3& a, const P3& b, F&& f) const;
+
+  /// Does any triangle meet the closed box (exact separating-axis test on candidates)?
+  bool overlaps(const Box<3>& box) const;
+
+  /// Squared distance from p to a box (0 inside).
+  static double box_distance2(const Box<3>& b, const P3& p);
+  /// Does segment [a, b] meet the closed box (slab test)?
+  static bool segment_meets_box(const P3& a, const P3& b, const Box<3>& box);
+
+ private:
+  struct Node {
+    Box<3> box;
+    std::int32_t first = 0;  ///< leaf: first slot; inner: index of the left child (right = +1)
+    std::int32_t count = 0;  ///< leaf: number of triangles; inner: 0
+  };
+  void build(std::int32_t node, std::int32_t begin, std::int32_t end, const std::vector<P3>& centroids);
+
+  std::vector<Node> nodes_;
+  std::vector<std::int32_t> ids_;             ///< triangle index in slot order
+  std::vector<std::int32_t> slot_;            ///< slot of each triangle
+  std::vector<std::array<P3, 3>> points_;     ///< corners in slot order (cache-friendly leaves)
+};
+
+// ---- templates ------------------------------------------------------------------------------
+
+template <class Skip> AabbTree::Closest AabbTree::closest_if(const P3& p, Skip&& skip) const {
+  Closest best;
+  if (nodes_.empty()) return best;
+  std::array<std::pair<std::int32_t, double>, 128> stack;
+  int top = 0;
+  stack[top++] = {0, box_distance2(nodes_[0].box, p)};
+  while (top > 0) {
+    const auto [n, d2] = stack[--top];
+    if (d2 >= best.distance2) continue;
+    const Node& node = nodes_[n];
+    if (node.count > 0) {
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s) {
+        if (skip(ids_[s])) continue;
+        const auto& q = points_[s];
+        const TrianglePoint tp = closest_on_triangle(p, q[0], q[1], q[2]);
+        const double dist2 = (tp.point - p).squaredNorm();
+        if (dist2 < best.distance2) best = {ids_[s], tp, dist2};
+      }
+      continue;
+    }
+    const double dl = box_distance2(nodes_[node.first].box, p);
+    const double dr = box_distance2(nodes_[node.first + 1].box, p);
+    // Push the farther child first so the nearer one is explored first.
+    if (dl <= dr) {
+      stack[top++] = {node.first + 1, dr};
+      stack[top++] = {node.first, dl};
+    } else {
+      stack[top++] = {node.first, dl};
+      stack[top++] = {node.first + 1, dr};
+    }
+  }
+  return best;
+}
+
+template <class F> void AabbTree::for_each_near(const P3& p, double radius, F&& f) const {
+  if (nodes_.empty()) return;
+  const double r2 = radius * radius;
+  std::array<std::int32_t, 128> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (box_distance2(node.box, p) > r2) continue;
+    if (node.count > 0) {
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
+    } else {
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+  }
+}
+
+template <class F> void AabbTree::for_each_in_box(const Box<3>& box, F&& f) const {
+  if (nodes_.empty()) return;
+  std::array<std::int32_t, 128> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!node.box.overlaps(box)) continue;
+    if (node.count > 0) {
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
+    } else {
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+  }
+}
+
+template <class F> void AabbTree::for_each_on_segment(const P3& a, const P3& b, F&& f) const {
+  if (nodes_.empty()) return;
+  std::array<std::int32_t, 128> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!segment_meets_box(a, b, node.box)) continue;
+    if (node.count > 0) {
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
+    } else {
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+  }
+}
+
+}  // namespace febemesh::dim3

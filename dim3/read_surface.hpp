@@ -1,0 +1,24 @@
+#pragma once
+// Reading closed triangle surfaces: OFF is parsed here (so that every problem is seen and named
+// with its line: OpenMesh drops non-manifold faces silently), STL (ASCII and binary), OBJ and
+// PLY go through OpenMesh (openmesh_surface.cpp), whose face count is checked against what the
+// file declares. Polygons are split into triangle fans. Bad input throws InputError
+// "<path>[:<line>]: <reason>". Topology and geometry checks come after (surface_checks.hpp).
+
+#include <istream>
+#include <string>
+
+#include "dim3/surface.hpp"
+
+namespace febemesh::dim3 {
+
+/// Reads `path` by extension (.off, .stl, .obj, .ply; case-insensitive).
+TriangleSoup read_surface(const std::string& path);
+
+/// Parses OFF text; `name` prefixes the error messages.
+TriangleSoup read_off(std::istream& in, const std::string& name);
+
+/// STL, OBJ or PLY through OpenMesh (the adapter; OpenMesh types stay in its .cpp).
+TriangleSoup read_with_openmesh(const std::string& path);
+
+}  // namespace febemesh::dim3

@@ -1,0 +1,47 @@
+#pragma once
+// What makes a triangle surface acceptable as the boundary of a solid, as functions (STYLE.md
+// §7): closed, manifold (edges and vertices), no zero-area triangles, no self-intersections,
+// orientable. validate_surface() runs them in that order, throws InputError naming the file
+// and the first problem with coordinates, and orients the surface outward.
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dim3/aabb_tree.hpp"
+#include "dim3/surface.hpp"
+
+namespace febemesh::dim3 {
+
+/// Edges with one triangle (holes in the surface).
+std::vector<std::int32_t> boundary_edges(const Surface& s);
+/// Edges with three or more triangles.
+std::vector<std::int32_t> non_manifold_edges(const Surface& s);
+/// Vertices whose triangles form more than one edge-connected fan (sheets touching at a point).
+std::vector<std::int32_t> non_manifold_vertices(const Surface& s);
+/// Triangles whose area is below 1e-12 of their longest edge squared (collinear corners).
+std::vector<std::int32_t> degenerate_triangles(const Surface& s);
+
+/// Pairs (t, u), t < u, of triangles sharing no vertex that intersect beyond the orientation
+/// tolerance (touching within it does not count), ascending; candidates pruned by the tree.
+std::vector<std::pair<std::int32_t, std::int32_t>> self_intersections(const Surface& s, const AabbTree& tree);
+/// The same by testing all pairs (slow twin for tests).
+std::vector<std::pair<std::int32_t, std::int32_t>> self_intersections_ref(const Surface& s);
+
+/// Is every manifold edge run in opposite directions by its two triangles?
+bool is_consistently_oriented(const Surface& s);
+/// How many other components enclose each component (ray parity, several directions).
+/// Requires a closed surface without self-intersections.
+std::vector<int> nesting_depths(const Surface& s, const AabbTree& tree);
+
+/// Makes each component consistently oriented, then flips whole components so that the signed
+/// volume of each is positive at even nesting depth and negative at odd depth (cavities),
+/// i.e. every normal points out of the solid. Returns the number of triangles flipped.
+/// Throws InputError if a component is not orientable.
+int orient_outward(Surface& s, const std::string& name);
+
+/// Every check above, then orient_outward. Throws InputError "<name>: <reason>".
+void validate_surface(Surface& s, const std::string& name);
+
+}  // namespace febemesh::dim3
