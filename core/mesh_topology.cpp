@@ -1,0 +1,201 @@
+// Gmsh reference-element tables (Gmsh MElement sources: edges_*, faces_*), oriented outward.
+
+#include "core/mesh_topology.hpp"
+
+#include <algorithm>
+
+#include "core/error.hpp"
+
+namespace febemesh {
+
+namespace {
+
+constexpr int line_facets[2][1] = {{0}, {1}};
+constexpr int tri_facets[3][2] = {{0, 1}, {1, 2}, {2, 0}};
+constexpr int quad_facets[4][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+constexpr int tet_facets[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {3, 1, 2}};
+constexpr int hex_facets[6][4] = {{0, 3, 2, 1}, {0, 1, 5, 4}, {0, 4, 7, 3},
+                                  {1, 2, 6, 5}, {2, 3, 7, 6}, {4, 5, 6, 7}};
+// Prism and pyramid mix triangles and quads; -1 pads the triangles.
+constexpr int prism_facets[5][4] = {{0, 2, 1, -1}, {3, 4, 5, -1}, {0, 1, 4, 3}, {0, 3, 5, 2}, {1, 2, 5, 4}};
+constexpr int pyramid_facets[5][4] = {{0, 1, 4, -1}, {3, 0, 4, -1}, {1, 2, 4, -1}, {2, 3, 4, -1}, {0, 3, 2, 1}};
+
+constexpr int line_edges[1][2] = {{0, 1}};
+constexpr int tri_edges[3][2] = {{0, 1}, {1, 2}, {2, 0}};
+constexpr int quad_edges[4][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+constexpr int tet_edges[6][2] = {{0, 1}, {1, 2}, {2, 0}, {3, 0}, {3, 2}, {3, 1}};
+constexpr int hex_edges[12][2] = {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 5}, {2, 3},
+                                  {2, 6}, {3, 7}, {4, 5}, {4, 7}, {5, 6}, {6, 7}};
+constexpr int prism_edges[9][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 4}, {2, 5}, {3, 4}, {3, 5}, {4, 5}};
+constexpr int pyramid_edges[8][2] = {{0, 1}, {0, 3}, {0, 4}, {1, 2}, {1, 4}, {2, 3}, {2, 4}, {3, 4}};
+
+template <std::size_t N, std::size_t M> std::span<const int> row(const int (&table)[N][M], int f) {
+  MESH_ASSERT(f >= 0 && static_cast<std::size_t>(f) < N, "facet " << f << " of " << N);
+  const int* r = table[f];
+  std::size_t n = M;
+  while (n > 0 && r[n - 1] < 0) --n;
+  return {r, n};
+}
+
+}  // namespace
+
+int n_facets(ElemType t) {
+  switch (t) {
+    case ElemType::Line2: return 2;
+    case ElemType::Tri3: return 3;
+    case ElemType::Quad4: return 4;
+    case ElemType::Tet4: return 4;
+    case ElemType::Hex8: return 6;
+    case ElemType::Prism6: return 5;
+    case ElemType::Pyramid5: return 5;
+  }
+  return 0;
+}
+
+int n_edges(ElemType t) {
+  switch (t) {
+    case ElemType::Line2: return 1;
+    case ElemType::Tri3: return 3;
+    case ElemType::Quad4: return 4;
+    case ElemType::Tet4: return 6;
+    case ElemType::Hex8: return 12;
+    case ElemType::Prism6: return 9;
+    case ElemType::Pyramid5: return 8;
+  }
+  return 0;
+}
+
+std::span<const int> facet_local_nodes(ElemType t, int f) {
+  switch (t) {
+    case ElemType::Line2: return row(line_facets, f);
+    case ElemType::Tri3: return row(tri_facets, f);
+    case ElemType::Quad4: return row(quad_facets, f);
+    case ElemType::Tet4: return row(tet_facets, f);
+    case ElemType::Hex8: return row(hex_facets, f);
+    case ElemType::Prism6: return row(prism_facets, f);
+    case ElemType::Pyramid5: return row(pyramid_facets, f);
+  }
+  return {};
+}
+
+ElemType facet_type(ElemType t, int f) {
+  switch (facet_local_nodes(t, f).size()) {
+    case 2: return ElemType::Line2;
+    case 3: return ElemType::Tri3;
+    default: return ElemType::Quad4;
+  }
+}
+
+std::array<int, 2> edge_local_nodes(ElemType t, int e) {
+  auto get = [e](const auto& table) {
+    MESH_ASSERT(e >= 0 && static_cast<std::size_t>(e) < std::size(table), "edge " << e);
+    return std::array<int, 2>{table[e][0], table[e][1]};
+  };
+  switch (t) {
+    case ElemType::Line2: return get(line_edges);
+    case ElemType::Tri3: return get(tri_edges);
+    case ElemType::Quad4: return get(quad_edges);
+    case ElemType::Tet4: return get(tet_edges);
+    case ElemType::Hex8: return get(hex_edges);
+    case ElemType::Prism6: return get(prism_edges);
+    case ElemType::Pyramid5: return get(pyramid_edges);
+  }
+  return {0, 0};
+}
+
+Facet facet_of(const Elements& els, ElemId e, int f) {
+  const ElemType t = els.type[e.v];
+  const auto local = facet_local_nodes(t, f);
+  const VertexId* nodes = els.nodes(e);
+  Facet out;
+  out.type = facet_type(t, f);
+  out.n = static_cast<int>(local.size());
+  for (int i = 0; i < out.n; ++i) out.node[i] = nodes[local[i]];
+  return out;
+}
+
+Facet as_facet(const Elements& els, ElemId e) {
+  Facet out;
+  out.type = els.type[e.v];
+  out.n = els.n_nodes_of(e);
+  MESH_ASSERT(out.n >= 2 && out.n <= 4, "element " << e.v << " is not a facet type");
+  for (int i = 0; i < out.n; ++i) out.node[i] = els.nodes(e)[i];
+  return out;
+}
+
+FacetKey key_of(const Facet& f) {
+  FacetKey k;
+  // Insertion sort of at most 4 ids (std::sort on a short prefix trips g++ 12's -Warray-bounds).
+  for (int i = 0; i < f.n; ++i) {
+    int j = i;
+    for (; j > 0 && k.v[j - 1] > f.node[i].v; --j) k.v[j] = k.v[j - 1];
+    k.v[j] = f.node[i].v;
+  }
+  return k;
+}
+
+int orientation_of(const Facet& f) {
+  if (f.n == 2) return f.node[0].v < f.node[1].v ? 1 : -1;
+  // Rotate the smallest node to the front; the cycle direction is then read off its neighbours.
+  int m = 0;
+  for (int i = 1; i < f.n; ++i)
+    if (f.node[i].v < f.node[m].v) m = i;
+  const int next = f.node[(m + 1) % f.n].v;
+  const int prev = f.node[(m + f.n - 1) % f.n].v;
+  return next < prev ? 1 : -1;
+}
+
+std::vector<FacetUse> facet_uses(const Elements& els) {
+  std::vector<FacetUse> uses;
+  std::size_t total = 0;
+  for (std::size_t e = 0; e < els.size(); ++e) total += static_cast<std::size_t>(n_facets(els.type[e]));
+  uses.reserve(total);
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int f = 0; f < n_facets(els.type[e]); ++f) {
+      const Facet fc = facet_of(els, id, f);
+      uses.push_back({key_of(fc), id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(orientation_of(fc))});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const FacetUse& a, const FacetUse& b) {
+    if (a.key != b.key) return a.key < b.key;
+    if (a.elem.v != b.elem.v) return a.elem.v < b.elem.v;
+    return a.local < b.local;
+  });
+  return uses;
+}
+
+std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
+  const std::vector<FacetUse> uses = facet_uses(solid);
+  std::vector<BoundaryFacet> out;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    if (j - i == 1) out.push_back({facet_of(solid, uses[i].elem, uses[i].local), uses[i].elem, uses[i].local});
+    i = j;
+  }
+  std::sort(out.begin(), out.end(), [](const BoundaryFacet& a, const BoundaryFacet& b) {
+    return a.elem.v != b.elem.v ? a.elem.v < b.elem.v : a.local < b.local;
+  });
+  return out;
+}
+
+std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
+  std::vector<std::array<VertexId, 2>> edges;
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const VertexId* nodes = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+    for (int k = 0; k < n_edges(els.type[e]); ++k) {
+      const auto [a, b] = edge_local_nodes(els.type[e], k);
+      VertexId u = nodes[a], w = nodes[b];
+      if (w < u) std::swap(u, w);
+      edges.push_back({u, w});
+    }
+  }
+  std::sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) {
+    return x[0].v != y[0].v ? x[0].v < y[0].v : x[1].v < y[1].v;
+  });
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+}  // namespace febemesh

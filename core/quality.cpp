@@ -1,0 +1,334 @@
+// Verdict quality measures, generic over the ambient dimension.
+
+#include "core/quality.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "core/mesh_topology.hpp"
+
+namespace febemesh {
+
+namespace {
+
+constexpr double rad_to_deg = 180.0 / std::numbers::pi;
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+/// Corner c with its neighbours (a, b[, d]) in right-handed order for a positive element.
+struct Corner {
+  int c, a, b, d;
+};
+constexpr Corner tri_corners[] = {{0, 1, 2, -1}, {1, 2, 0, -1}, {2, 0, 1, -1}};
+constexpr Corner quad_corners[] = {{0, 1, 3, -1}, {1, 2, 0, -1}, {2, 3, 1, -1}, {3, 0, 2, -1}};
+constexpr Corner tet_corners[] = {{0, 1, 2, 3}, {1, 2, 0, 3}, {2, 0, 1, 3}, {3, 0, 2, 1}};
+constexpr Corner hex_corners[] = {{0, 1, 3, 4}, {1, 2, 0, 5}, {2, 3, 1, 6}, {3, 0, 2, 7},
+                                  {4, 7, 5, 0}, {5, 4, 6, 1}, {6, 5, 7, 2}, {7, 6, 4, 3}};
+constexpr Corner prism_corners[] = {{0, 1, 2, 3}, {1, 2, 0, 4}, {2, 0, 1, 5},
+                                    {3, 5, 4, 0}, {4, 3, 5, 1}, {5, 4, 3, 2}};
+constexpr Corner pyramid_corners[] = {{0, 1, 3, 4}, {1, 2, 0, 4}, {2, 3, 1, 4}, {3, 0, 2, 4}};
+
+std::span<const Corner> corners(ElemType t) {
+  switch (t) {
+    case ElemType::Line2: return {};
+    case ElemType::Tri3: return tri_corners;
+    case ElemType::Quad4: return quad_corners;
+    case ElemType::Tet4: return tet_corners;
+    case ElemType::Hex8: return hex_corners;
+    case ElemType::Prism6: return prism_corners;
+    case ElemType::Pyramid5: return pyramid_corners;
+  }
+  return {};
+}
+
+double normalisation(ElemType t) {
+  switch (t) {
+    case ElemType::Tri3:
+    case ElemType::Prism6: return 2.0 / std::sqrt(3.0);
+    case ElemType::Tet4:
+    case ElemType::Pyramid5: return std::sqrt(2.0);
+    default: return 1.0;
+  }
+}
+
+/// Signed (Dim == 2) or unsigned (Dim == 3) area of the parallelogram spanned by a and b.
+template <int Dim> double cross2(const Point<Dim>& a, const Point<Dim>& b) {
+  if constexpr (Dim == 2) {
+    return a.x() * b.y() - a.y() * b.x();
+  } else {
+    return a.cross(b).norm();
+  }
+}
+
+template <int Dim> double det3(const Point<Dim>& a, const Point<Dim>& b, const Point<Dim>& c) {
+  if constexpr (Dim == 3) {
+    return a.dot(b.cross(c));
+  } else {
+    MESH_ASSERT(false, "3D element in a 2D mesh");
+    (void)a, (void)b, (void)c;
+    return 0.0;
+  }
+}
+
+/// Corner Jacobian and the product of its edge lengths.
+template <int Dim> std::pair<double, double> corner_jacobian(ElemType t, const Corner& k, std::span<const Point<Dim>> p) {
+  const Point<Dim> a = p[k.a] - p[k.c];
+  const Point<Dim> b = p[k.b] - p[k.c];
+  if (dimension(t) == 2) return {cross2<Dim>(a, b), a.norm() * b.norm()};
+  const Point<Dim> d = p[k.d] - p[k.c];
+  return {det3<Dim>(a, b, d), a.norm() * b.norm() * d.norm()};
+}
+
+template <int Dim> double angle_deg(const Point<Dim>& a, const Point<Dim>& b) {
+  const double na = a.norm(), nb = b.norm();
+  if (na == 0.0 || nb == 0.0) return 0.0;
+  return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * rad_to_deg;
+}
+
+/// Newell normal of facet f (area-weighted, outward).
+Point<3> facet_normal(ElemType t, int f, std::span<const Point<3>> p) {
+  const auto local = facet_local_nodes(t, f);
+  Point<3> n = Point<3>::Zero();
+  const Point<3>& o = p[local[0]];
+  for (std::size_t i = 1; i + 1 < local.size(); ++i) n += (p[local[i]] - o).cross(p[local[i + 1]] - o);
+  return 0.5 * n;
+}
+
+bool facet_has_edge(std::span<const int> facet, int a, int b) {
+  const std::size_t n = facet.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const int u = facet[i], w = facet[(i + 1) % n];
+    if ((u == a && w == b) || (u == b && w == a)) return true;
+  }
+  return false;
+}
+
+/// Dihedral angles (degrees) of a 3D element at each of its edges: min and max.
+std::pair<double, double> dihedral_range(ElemType t, std::span<const Point<3>> p) {
+  double lo = inf, hi = -inf;
+  for (int e = 0; e < n_edges(t); ++e) {
+    const auto [a, b] = edge_local_nodes(t, e);
+    int faces[2] = {-1, -1};
+    int found = 0;
+    for (int f = 0; f < n_facets(t) && found < 2; ++f)
+      if (facet_has_edge(facet_local_nodes(t, f), a, b)) faces[found++] = f;
+    MESH_ASSERT(found == 2, "edge " << e << " of " << name(t));
+    const double between_normals = angle_deg<3>(facet_normal(t, faces[0], p), facet_normal(t, faces[1], p));
+    const double dihedral = 180.0 - between_normals;
+    lo = std::min(lo, dihedral);
+    hi = std::max(hi, dihedral);
+  }
+  return {lo, hi};
+}
+
+template <int Dim> std::pair<double, double> edge_length_range(ElemType t, std::span<const Point<Dim>> p, double* sum = nullptr) {
+  double lo = inf, hi = 0.0, s = 0.0;
+  for (int e = 0; e < n_edges(t); ++e) {
+    const auto [a, b] = edge_local_nodes(t, e);
+    const double l = (p[b] - p[a]).norm();
+    lo = std::min(lo, l);
+    hi = std::max(hi, l);
+    s += l;
+  }
+  if (sum != nullptr) *sum = s;
+  return {lo, hi};
+}
+
+template <int Dim> double tet_radius_ratio(std::span<const Point<Dim>> p) {
+  if constexpr (Dim == 3) {
+    const Point<3> a = p[1] - p[0], b = p[2] - p[0], c = p[3] - p[0];
+    const double det = a.dot(b.cross(c));
+    if (det <= 0.0) return inf;
+    const Point<3> num = a.squaredNorm() * b.cross(c) + b.squaredNorm() * c.cross(a) + c.squaredNorm() * a.cross(b);
+    const double circum = num.norm() / (2.0 * det);
+    double area = 0.0;
+    for (int f = 0; f < 4; ++f) area += facet_normal(ElemType::Tet4, f, p).norm();
+    const double in = det / (2.0 * area);  // r = 3V / A with V = det / 6
+    return circum / (3.0 * in);
+  } else {
+    (void)p;
+    return 0.0;
+  }
+}
+
+}  // namespace
+
+template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<Dim>> p) {
+  MESH_ASSERT(static_cast<int>(p.size()) == n_nodes(t), name(t) << " with " << p.size() << " points");
+  if (t == ElemType::Line2) return (p[1] - p[0]).norm();
+  double m = inf;
+  for (const Corner& k : corners(t)) m = std::min(m, corner_jacobian<Dim>(t, k, p).first);
+  return m;
+}
+
+template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>> p) {
+  if (t == ElemType::Line2) return (p[1] - p[0]).norm() > 0.0 ? 1.0 : 0.0;
+  double m = inf;
+  for (const Corner& k : corners(t)) {
+    const auto [jac, lengths] = corner_jacobian<Dim>(t, k, p);
+    m = std::min(m, lengths > 0.0 ? jac / lengths : 0.0);
+  }
+  return std::clamp(m * normalisation(t), -1.0, 1.0);
+}
+
+template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>> p) {
+  switch (t) {
+    case ElemType::Line2: return (p[1] - p[0]).norm();
+    case ElemType::Tri3: return 0.5 * cross2<Dim>(p[1] - p[0], p[2] - p[0]);
+    case ElemType::Quad4:
+      // Diagonals' cross product: exact for a planar quad, also non-convex ones.
+      return 0.5 * cross2<Dim>(p[2] - p[0], p[3] - p[1]);
+    default: break;
+  }
+  if constexpr (Dim == 3) {
+    // Divergence theorem over the (triangulated) faces, relative to the first node.
+    double v = 0.0;
+    for (int f = 0; f < n_facets(t); ++f) {
+      const auto local = facet_local_nodes(t, f);
+      for (std::size_t i = 1; i + 1 < local.size(); ++i) {
+        const Point<3> a = p[local[0]] - p[0], b = p[local[i]] - p[0], c = p[local[i + 1]] - p[0];
+        v += a.dot(b.cross(c));
+      }
+    }
+    return v / 6.0;
+  } else {
+    MESH_ASSERT(false, "3D element in a 2D mesh");
+    return 0.0;
+  }
+}
+
+template <int Dim> ElementQuality element_quality(ElemType t, std::span<const Point<Dim>> p) {
+  ElementQuality q;
+  q.scaled_jacobian = scaled_jacobian<Dim>(t, p);
+  if (t == ElemType::Line2) {
+    q.min_angle_deg = q.max_angle_deg = 180.0;
+    q.aspect_ratio = 1.0;
+    return q;
+  }
+  if (dimension(t) == 2) {
+    q.min_angle_deg = inf;
+    q.max_angle_deg = -inf;
+    for (const Corner& k : corners(t)) {
+      const double a = angle_deg<Dim>(p[k.a] - p[k.c], p[k.b] - p[k.c]);
+      q.min_angle_deg = std::min(q.min_angle_deg, a);
+      q.max_angle_deg = std::max(q.max_angle_deg, a);
+    }
+    double sum = 0.0;
+    const double longest = edge_length_range<Dim>(t, p, &sum).second;
+    const double area = std::abs(signed_measure<Dim>(t, p));
+    const double denom = (t == ElemType::Tri3 ? 4.0 * std::sqrt(3.0) : 4.0) * area;
+    q.aspect_ratio = denom > 0.0 ? longest * sum / denom : inf;
+    return q;
+  }
+  if constexpr (Dim == 3) {
+    std::tie(q.min_angle_deg, q.max_angle_deg) = dihedral_range(t, p);
+    if (t == ElemType::Tet4) {
+      const double longest = edge_length_range<3>(t, p).second;
+      double area = 0.0;
+      for (int f = 0; f < 4; ++f) area += facet_normal(t, f, p).norm();
+      const double volume = std::abs(signed_measure<3>(t, p));
+      q.aspect_ratio = volume > 0.0 ? longest * area / (6.0 * std::sqrt(6.0) * volume) : inf;
+      q.radius_ratio = tet_radius_ratio<3>(p);
+    } else {
+      const auto [shortest, longest] = edge_length_range<3>(t, p);
+      q.aspect_ratio = shortest > 0.0 ? longest / shortest : inf;
+    }
+  }
+  return q;
+}
+
+template <int Dim> ElemPoints<Dim> element_points(const Elements& els, ElemId e, const std::vector<Point<Dim>>& pts) {
+  ElemPoints<Dim> out;
+  out.n = els.n_nodes_of(e);
+  const VertexId* nodes = els.nodes(e);
+  for (int i = 0; i < out.n; ++i) out.p[i] = pts[nodes[i].v];
+  return out;
+}
+
+template <int Dim> std::vector<double> scaled_jacobians(const Elements& els, const std::vector<Point<Dim>>& pts) {
+  std::vector<double> out(els.size());
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const auto ep = element_points<Dim>(els, ElemId{static_cast<std::int32_t>(e)}, pts);
+    out[e] = scaled_jacobian<Dim>(els.type[e], ep.span());
+  }
+  return out;
+}
+
+template <int Dim> QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg) {
+  QualitySummary s;
+  s.sliver_threshold_deg = sliver_threshold_deg;
+  s.n_elements = mesh.solid.size();
+  if (s.n_elements == 0) return s;
+  s.min_scaled_jacobian = inf;
+  s.min_angle_deg = inf;
+  s.max_angle_deg = -inf;
+  double sum_sj = 0.0;
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    const ElemType t = mesh.solid.type[e];
+    const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+    const ElementQuality q = element_quality<Dim>(t, ep.span());
+    s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, q.scaled_jacobian);
+    sum_sj += q.scaled_jacobian;
+    s.min_angle_deg = std::min(s.min_angle_deg, q.min_angle_deg);
+    s.max_angle_deg = std::max(s.max_angle_deg, q.max_angle_deg);
+    s.max_aspect_ratio = std::max(s.max_aspect_ratio, q.aspect_ratio);
+    s.max_radius_ratio = std::max(s.max_radius_ratio, q.radius_ratio);
+    const int bin = std::clamp(static_cast<int>(std::floor((q.scaled_jacobian + 1.0) / 0.2)), 0, 9);
+    ++s.scaled_jacobian_histogram[bin];
+    if (q.min_angle_deg < sliver_threshold_deg) ++s.n_slivers;
+    s.measure += signed_measure<Dim>(t, ep.span());
+  }
+  s.mean_scaled_jacobian = sum_sj / static_cast<double>(s.n_elements);
+  return s;
+}
+
+template <int Dim> double solid_measure(const Mesh<Dim>& mesh) {
+  double m = 0.0;
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+    m += signed_measure<Dim>(mesh.solid.type[e], ep.span());
+  }
+  return m;
+}
+
+template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh) {
+  if (mesh.interface.empty()) return 0.0;
+  // Relative to the box centre: keeps the cancellation error small far from the origin.
+  Box<Dim> box = Box<Dim>::empty();
+  for (const VertexId v : mesh.interface.node) box.expand(mesh.points[v.v]);
+  const Point<Dim> o = box.center();
+  double m = 0.0;
+  for (std::size_t e = 0; e < mesh.interface.size(); ++e) {
+    const VertexId* n = mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const int k = mesh.interface.n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
+    if constexpr (Dim == 2) {
+      const Point<2> a = mesh.points[n[0].v] - o, b = mesh.points[n[1].v] - o;
+      m += 0.5 * (a.x() * b.y() - a.y() * b.x());
+    } else {
+      const Point<3> a = mesh.points[n[0].v] - o;
+      for (int i = 1; i + 1 < k; ++i) {
+        const Point<3> b = mesh.points[n[i].v] - o, c = mesh.points[n[i + 1].v] - o;
+        m += a.dot(b.cross(c)) / 6.0;
+      }
+    }
+  }
+  return m;
+}
+
+#define FEBEMESH_INSTANTIATE(D)                                                                     \
+  template double min_corner_jacobian<D>(ElemType, std::span<const Point<D>>);                     \
+  template double scaled_jacobian<D>(ElemType, std::span<const Point<D>>);                         \
+  template double signed_measure<D>(ElemType, std::span<const Point<D>>);                          \
+  template ElementQuality element_quality<D>(ElemType, std::span<const Point<D>>);                 \
+  template ElemPoints<D> element_points<D>(const Elements&, ElemId, const std::vector<Point<D>>&); \
+  template std::vector<double> scaled_jacobians<D>(const Elements&, const std::vector<Point<D>>&); \
+  template QualitySummary summarize_quality<D>(const Mesh<D>&, double);                            \
+  template double solid_measure<D>(const Mesh<D>&);                                                \
+  template double interface_enclosed_measure<D>(const Mesh<D>&);
+FEBEMESH_INSTANTIATE(2)
+FEBEMESH_INSTANTIATE(3)
+#undef FEBEMESH_INSTANTIATE
+
+}  // namespace febemesh

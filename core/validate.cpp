@@ -1,0 +1,431 @@
+// Exact validation of a Mesh<Dim>: topology by sorted facet keys (integer node ids), geometry
+// (hanging and duplicate nodes) by a k-d tree over the used nodes with element-relative tolerances.
+
+#include "core/validate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+#include "core/mesh_topology.hpp"
+#include "core/quality.hpp"
+
+namespace febemesh {
+
+namespace {
+
+/// Implicit k-d tree over a subset of the points (ids), leaves of at most 8 points.
+template <int Dim> class PointTree {
+ public:
+  PointTree(const std::vector<Point<Dim>>& pts, std::vector<std::int32_t> ids) : pts_(pts), ids_(std::move(ids)) {
+    build(0, ids_.size(), 0);
+  }
+
+  /// Calls visit(id) for every point inside the closed box.
+  template <class Visit> void query(const Box<Dim>& box, Visit&& visit) const {
+    query(0, ids_.size(), 0, box, visit);
+  }
+
+ private:
+  static constexpr std::size_t leaf_size = 8;
+
+  void build(std::size_t lo, std::size_t hi, int depth) {
+    if (hi - lo <= leaf_size) return;
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const int axis = depth % Dim;
+    std::nth_element(ids_.begin() + static_cast<std::ptrdiff_t>(lo), ids_.begin() + static_cast<std::ptrdiff_t>(mid),
+                     ids_.begin() + static_cast<std::ptrdiff_t>(hi), [&](std::int32_t a, std::int32_t b) {
+                       const double ca = pts_[a][axis], cb = pts_[b][axis];
+                       return ca != cb ? ca < cb : a < b;
+                     });
+    build(lo, mid, depth + 1);
+    build(mid + 1, hi, depth + 1);
+  }
+
+  template <class Visit> void query(std::size_t lo, std::size_t hi, int depth, const Box<Dim>& box, Visit& visit) const {
+    if (hi - lo <= leaf_size) {
+      for (std::size_t i = lo; i < hi; ++i)
+        if (box.contains(pts_[ids_[i]])) visit(ids_[i]);
+      return;
+    }
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const int axis = depth % Dim;
+    const double split = pts_[ids_[mid]][axis];
+    if (box.contains(pts_[ids_[mid]])) visit(ids_[mid]);
+    if (box.lo[axis] <= split) query(lo, mid, depth + 1, box, visit);
+    if (box.hi[axis] >= split) query(mid + 1, hi, depth + 1, box, visit);
+  }
+
+  const std::vector<Point<Dim>>& pts_;
+  std::vector<std::int32_t> ids_;
+};
+
+class Problems {
+ public:
+  Problems(ValidationReport& r, int max) : r_(r), max_(max) {}
+  template <class Write> void add(Write&& write) {
+    ++r_.n_problems;
+    if (static_cast<int>(r_.problems.size()) >= max_) return;
+    std::ostringstream os;
+    os.precision(17);
+    write(os);
+    r_.problems.push_back(os.str());
+  }
+
+ private:
+  ValidationReport& r_;
+  int max_;
+};
+
+template <int Dim> std::string fmt(const Point<Dim>& p) {
+  std::ostringstream os;
+  os.precision(17);
+  os << "(" << p[0];
+  for (int d = 1; d < Dim; ++d) os << ", " << p[d];
+  os << ")";
+  return os.str();
+}
+
+template <int Dim> std::string fmt_element(const Elements& els, std::size_t e, const std::vector<Point<Dim>>& pts) {
+  std::ostringstream os;
+  os << name(els.type[e]) << " " << e << " [";
+  const VertexId* n = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+  for (int i = 0; i < els.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}); ++i) {
+    os << (i ? " " : "") << n[i].v;
+    if (n[i].v >= 0 && static_cast<std::size_t>(n[i].v) < pts.size()) os << fmt<Dim>(pts[n[i].v]);
+  }
+  os << "]";
+  return os.str();
+}
+
+std::string fmt_key(const FacetKey& k) {
+  std::ostringstream os;
+  os << "{";
+  for (int i = 0; i < 4 && k.v[i] >= 0; ++i) os << (i ? " " : "") << k.v[i];
+  os << "}";
+  return os.str();
+}
+
+/// Elements with the right dimension, node count and node ids in range.
+template <int Dim> void check_elements(const Elements& els, int dim, const char* group, std::size_t n_points,
+                                       ValidationReport& r, Problems& problems) {
+  if (els.offset.size() != els.size() + 1 || els.offset.back() != static_cast<std::int32_t>(els.node.size())) {
+    ++r.bad_elements;
+    problems.add([&](auto& os) { os << group << ": offset array inconsistent with the node array"; });
+    return;
+  }
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    bool ok = dimension(els.type[e]) == dim && els.n_nodes_of(id) == n_nodes(els.type[e]);
+    for (int i = 0; ok && i < els.n_nodes_of(id); ++i)
+      ok = els.nodes(id)[i].v >= 0 && static_cast<std::size_t>(els.nodes(id)[i].v) < n_points;
+    if (!ok) {
+      ++r.bad_elements;
+      problems.add([&](auto& os) {
+        os << group << " element " << e << " (" << name(els.type[e]) << "): wrong dimension, node count or node id";
+      });
+    }
+  }
+}
+
+/// Is p within tol of the open segment (a, b), away from its ends by more than tol?
+template <int Dim> bool on_open_segment(const Point<Dim>& p, const Point<Dim>& a, const Point<Dim>& b, double rel) {
+  const Point<Dim> ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (len2 == 0.0) return false;
+  const double t = (p - a).dot(ab) / len2;
+  if (t <= rel || t >= 1.0 - rel) return false;
+  return (p - a - t * ab).squaredNorm() <= rel * rel * len2;
+}
+
+/// Barycentric coordinates of p's projection on triangle (a, b, c) and its distance to the plane.
+std::pair<Eigen::Vector3d, double> barycentric(const Point<3>& p, const Point<3>& a, const Point<3>& b, const Point<3>& c) {
+  const Point<3> n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  if (n2 == 0.0) return {Eigen::Vector3d::Constant(-1.0), 0.0};
+  const double l0 = (b - p).cross(c - p).dot(n) / n2;
+  const double l1 = (c - p).cross(a - p).dot(n) / n2;
+  return {Eigen::Vector3d(l0, l1, 1.0 - l0 - l1), std::abs((p - a).dot(n)) / std::sqrt(n2)};
+}
+
+/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
+bool on_facet_interior(const Point<3>& p, const Facet& f, const std::vector<Point<3>>& pts, double rel) {
+  double h = 0.0;
+  for (int i = 0; i < f.n; ++i) h = std::max(h, (pts[f.node[(i + 1) % f.n].v] - pts[f.node[i].v]).norm());
+  if (h == 0.0) return false;
+  const auto& a = pts[f.node[0].v];
+  if (f.n == 3) {
+    const auto [l, dist] = barycentric(p, a, pts[f.node[1].v], pts[f.node[2].v]);
+    return dist <= rel * h && l.minCoeff() > rel;
+  }
+  // Quad as triangles (0,1,2) and (0,2,3): the diagonal 0-2 belongs to the interior.
+  const auto& c = pts[f.node[2].v];
+  const auto [l1, d1] = barycentric(p, a, pts[f.node[1].v], c);
+  if (d1 <= rel * h && l1[0] > rel && l1[2] > rel && l1[1] >= -rel) return true;
+  const auto [l2, d2] = barycentric(p, a, c, pts[f.node[3].v]);
+  return d2 <= rel * h && l2[0] > rel && l2[2] > rel && l2[1] >= -rel;
+}
+
+template <int Dim> Box<Dim> inflated_box(std::initializer_list<Point<Dim>> corners, double margin) {
+  Box<Dim> b = Box<Dim>::empty();
+  for (const auto& c : corners) b.expand(c);
+  b.lo.array() -= margin;
+  b.hi.array() += margin;
+  return b;
+}
+
+}  // namespace
+
+std::string ValidationReport::summary() const {
+  std::ostringstream os;
+  os << (valid ? "valid" : "INVALID") << " mesh: " << n_points << " points, " << n_solid << " solid, "
+     << n_interface << " interface elements; Euler characteristic " << euler;
+  if (expected_euler) os << " (expected " << *expected_euler << ")";
+  os << "\n";
+  auto line = [&](const char* what, std::size_t n) {
+    if (n != 0) os << "  " << what << ": " << n << "\n";
+  };
+  line("bad elements", bad_elements);
+  line("inverted elements", inverted);
+  line("non-conforming facets", nonconforming_facets);
+  line("hanging nodes", hanging_nodes);
+  line("interface: missing boundary facets", interface_missing);
+  line("interface: extra elements", interface_extra);
+  line("interface: reversed elements", interface_reversed);
+  line("unused nodes", unused_nodes);
+  line("duplicate nodes", duplicate_nodes);
+  line("interface nodes off the boundary", off_boundary_nodes);
+  line("attribute arrays of the wrong size", attribute_mismatch);
+  for (const auto& p : problems) os << "  - " << p << "\n";
+  if (n_problems > problems.size()) os << "  ... and " << n_problems - problems.size() << " more problems\n";
+  return os.str();
+}
+
+template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh) {
+  std::vector<std::int32_t> used;
+  used.reserve(mesh.solid.node.size());
+  for (const VertexId v : mesh.solid.node) used.push_back(v.v);
+  std::sort(used.begin(), used.end());
+  const long v = std::unique(used.begin(), used.end()) - used.begin();
+  const long e = static_cast<long>(unique_edges(mesh.solid).size());
+  if constexpr (Dim == 2) {
+    return v - e + static_cast<long>(mesh.solid.size());
+  } else {
+    const std::vector<FacetUse> uses = facet_uses(mesh.solid);
+    long f = 0;
+    for (std::size_t i = 0; i < uses.size(); ++i) f += (i == 0 || uses[i].key != uses[i - 1].key);
+    return v - e + f - static_cast<long>(mesh.solid.size());
+  }
+}
+
+template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options) {
+  ValidationReport r;
+  Problems problems(r, options.max_problems);
+  const auto& pts = mesh.points;
+  r.n_points = pts.size();
+  r.n_solid = mesh.solid.size();
+  r.n_interface = mesh.interface.size();
+  r.expected_euler = options.expected_euler;
+
+  check_elements<Dim>(mesh.solid, Dim, "solid", pts.size(), r, problems);
+  check_elements<Dim>(mesh.interface, Dim - 1, "interface", pts.size(), r, problems);
+  for (const auto* attr : {&mesh.level, &mesh.from_boundary_cell}) {
+    if (!attr->empty() && attr->size() != mesh.solid.size()) {
+      ++r.attribute_mismatch;
+      problems.add([&](auto& os) {
+        os << (attr == &mesh.level ? "level" : "from_boundary_cell") << " has " << attr->size() << " entries for "
+           << mesh.solid.size() << " solid elements";
+      });
+    }
+  }
+  if (r.bad_elements != 0) return r;  // the checks below index nodes and tables by element type
+
+  // Orientation: every corner.
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, pts);
+    const double j = min_corner_jacobian<Dim>(mesh.solid.type[e], ep.span());
+    if (!(j > 0.0)) {
+      ++r.inverted;
+      problems.add([&](auto& os) {
+        os << "inverted solid " << fmt_element<Dim>(mesh.solid, e, pts) << ": min corner Jacobian " << j;
+      });
+    }
+  }
+
+  // Conformity: group facet uses by key.
+  const std::vector<FacetUse> uses = facet_uses(mesh.solid);
+  std::vector<FacetUse> boundary;  // used once; sorted by key
+  std::vector<FacetKey> unique_facets;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    unique_facets.push_back(uses[i].key);
+    if (j - i == 1) {
+      boundary.push_back(uses[i]);
+    } else if (j - i > 2 || uses[i].orientation == uses[i + 1].orientation) {
+      ++r.nonconforming_facets;
+      problems.add([&](auto& os) {
+        os << "facet " << fmt_key(uses[i].key) << " used " << (j - i) << " times"
+           << (j - i == 2 ? " in the same orientation" : "") << " by solid elements";
+        for (std::size_t k = i; k < j; ++k) os << " " << uses[k].elem.v;
+        os << " at " << fmt<Dim>(pts[uses[i].key.v[0]]);
+      });
+    }
+    i = j;
+  }
+
+  // Interface == boundary facets, same orientation.
+  {
+    std::vector<char> matched(boundary.size(), 0);
+    for (std::size_t e = 0; e < mesh.interface.size(); ++e) {
+      const Facet f = as_facet(mesh.interface, ElemId{static_cast<std::int32_t>(e)});
+      const FacetKey k = key_of(f);
+      const auto it = std::lower_bound(boundary.begin(), boundary.end(), k,
+                                       [](const FacetUse& u, const FacetKey& key) { return u.key < key; });
+      const std::size_t bi = static_cast<std::size_t>(it - boundary.begin());
+      if (it == boundary.end() || it->key != k || matched[bi]) {
+        ++r.interface_extra;
+        problems.add([&](auto& os) {
+          os << "interface " << fmt_element<Dim>(mesh.interface, e, pts)
+             << (it != boundary.end() && it->key == k ? " repeats a boundary facet" : " is not a boundary facet of the solid");
+        });
+        continue;
+      }
+      matched[bi] = 1;
+      if (orientation_of(f) != it->orientation) {
+        ++r.interface_reversed;
+        problems.add([&](auto& os) {
+          os << "interface " << fmt_element<Dim>(mesh.interface, e, pts) << " is reversed (against solid element "
+             << it->elem.v << ")";
+        });
+      }
+    }
+    for (std::size_t b = 0; b < boundary.size(); ++b) {
+      if (matched[b]) continue;
+      ++r.interface_missing;
+      problems.add([&](auto& os) {
+        os << "boundary facet " << fmt_key(boundary[b].key) << " of solid element " << boundary[b].elem.v
+           << " has no interface element, at " << fmt<Dim>(pts[boundary[b].key.v[0]]);
+      });
+    }
+    r.interface_mismatch = r.interface_missing + r.interface_extra + r.interface_reversed;
+  }
+
+  // Node usage.
+  std::vector<char> used(pts.size(), 0), solid_used(pts.size(), 0);
+  for (const VertexId v : mesh.solid.node) used[v.v] = solid_used[v.v] = 1;
+  for (const VertexId v : mesh.interface.node) used[v.v] = 1;
+  std::vector<std::int32_t> used_ids;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (used[i]) {
+      used_ids.push_back(static_cast<std::int32_t>(i));
+      continue;
+    }
+    ++r.unused_nodes;
+    problems.add([&](auto& os) { os << "node " << i << " at " << fmt<Dim>(pts[i]) << " is used by no element"; });
+  }
+
+  const PointTree<Dim> tree(pts, used_ids);
+
+  // Duplicate nodes.
+  {
+    Box<Dim> all = Box<Dim>::empty();
+    for (const auto id : used_ids) all.expand(pts[id]);
+    const double tol = used_ids.empty() ? 0.0 : options.duplicate_rel_tol * all.extent().norm();
+    for (const auto i : used_ids) {
+      std::int32_t first = i;
+      tree.query(inflated_box<Dim>({pts[i]}, tol), [&](std::int32_t j) {
+        if (j < first && (pts[j] - pts[i]).norm() <= tol) first = j;
+      });
+      if (first == i) continue;
+      ++r.duplicate_nodes;
+      problems.add([&](auto& os) { os << "node " << i << " duplicates node " << first << " at " << fmt<Dim>(pts[i]); });
+    }
+  }
+
+  // Hanging nodes: on the interior of an edge (both dimensions) or of a facet (3D).
+  {
+    const double rel = options.hanging_rel_tol;
+    std::vector<char> hanging(pts.size(), 0);
+    auto report = [&](std::int32_t c, const std::string& where) {
+      if (hanging[c]) return;
+      hanging[c] = 1;
+      ++r.hanging_nodes;
+      problems.add([&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
+    };
+    for (const auto& [a, b] : unique_edges(mesh.solid)) {
+      const Point<Dim>&pa = pts[a.v], &pb = pts[b.v];
+      const double margin = rel * (pb - pa).norm();
+      tree.query(inflated_box<Dim>({pa, pb}, margin), [&](std::int32_t c) {
+        if (c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pa, pb, rel))
+          report(c, "edge " + std::to_string(a.v) + "-" + std::to_string(b.v));
+      });
+    }
+    if constexpr (Dim == 3) {
+      for (std::size_t i = 0; i < uses.size(); ++i) {
+        if (i > 0 && uses[i].key == uses[i - 1].key) continue;
+        const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
+        Box<3> box = Box<3>::empty();
+        double h = 0.0;
+        for (int k = 0; k < f.n; ++k) {
+          box.expand(pts[f.node[k].v]);
+          h = std::max(h, (pts[f.node[(k + 1) % f.n].v] - pts[f.node[k].v]).norm());
+        }
+        box.lo.array() -= rel * h;
+        box.hi.array() += rel * h;
+        tree.query(box, [&](std::int32_t c) {
+          for (int k = 0; k < f.n; ++k)
+            if (f.node[k].v == c) return;
+          if (on_facet_interior(pts[c], f, pts, rel)) report(c, "facet " + fmt_key(uses[i].key));
+        });
+      }
+    }
+  }
+
+  // Interface nodes on the boundary.
+  if (options.boundary_distance) {
+    std::vector<std::int32_t> nodes;
+    for (const VertexId v : mesh.interface.node) nodes.push_back(v.v);
+    std::sort(nodes.begin(), nodes.end());
+    nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+    for (const auto v : nodes) {
+      const double d = std::abs(options.boundary_distance(pts[v]));
+      r.max_boundary_distance = std::max(r.max_boundary_distance, d);
+      if (!(d <= options.boundary_tolerance)) {
+        ++r.off_boundary_nodes;
+        problems.add([&](auto& os) {
+          os << "interface node " << v << " at " << fmt<Dim>(pts[v]) << " is " << d << " from the boundary";
+        });
+      }
+    }
+  }
+
+  // Euler characteristic of the solid.
+  {
+    const long v = std::accumulate(solid_used.begin(), solid_used.end(), 0L);
+    const long e = static_cast<long>(unique_edges(mesh.solid).size());
+    r.euler = Dim == 2 ? v - e + static_cast<long>(mesh.solid.size())
+                       : v - e + static_cast<long>(unique_facets.size()) - static_cast<long>(mesh.solid.size());
+    if (options.expected_euler && *options.expected_euler != r.euler)
+      problems.add([&](auto& os) { os << "Euler characteristic " << r.euler << ", expected " << *options.expected_euler; });
+  }
+
+  r.valid = r.bad_elements == 0 && r.inverted == 0 && r.nonconforming_facets == 0 && r.hanging_nodes == 0 &&
+            r.interface_mismatch == 0 && r.unused_nodes == 0 && r.duplicate_nodes == 0 && r.off_boundary_nodes == 0 &&
+            r.attribute_mismatch == 0 && (!options.expected_euler || *options.expected_euler == r.euler);
+  return r;
+}
+
+template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options) {
+  return validate<Dim>(mesh, options).valid;
+}
+
+template ValidationReport validate<2>(const Mesh<2>&, const ValidateOptions<2>&);
+template ValidationReport validate<3>(const Mesh<3>&, const ValidateOptions<3>&);
+template bool is_valid<2>(const Mesh<2>&, const ValidateOptions<2>&);
+template bool is_valid<3>(const Mesh<3>&, const ValidateOptions<3>&);
+template long euler_characteristic<2>(const Mesh<2>&);
+template long euler_characteristic<3>(const Mesh<3>&);
+
+}  // namespace febemesh

@@ -1,0 +1,68 @@
+#pragma once
+// The validity contract of DESIGN.md ("Validity and quality"), checked exactly: orientation of
+// every corner, conformity, hanging nodes, interface == boundary facets, node usage, distance of
+// interface nodes to the boundary, Euler characteristic. Pipeline tests call this on every output.
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/mesh.hpp"
+
+namespace febemesh {
+
+template <int Dim> struct ValidateOptions {
+  /// Expected V - E + F (2D) / V - E + F - C (3D) of the solid; unchecked when empty.
+  std::optional<long> expected_euler;
+  /// Distance of a point to the input boundary; interface nodes farther than
+  /// boundary_tolerance are reported. Unchecked when empty.
+  std::function<double(const Point<Dim>&)> boundary_distance;
+  double boundary_tolerance = 1e-6;
+  /// A node closer than hanging_rel_tol * (edge or facet size) to the interior of an edge or
+  /// facet of which it is not a vertex is a hanging node.
+  double hanging_rel_tol = 1e-6;
+  /// Two nodes closer than duplicate_rel_tol * (bounding-box diagonal) are duplicates.
+  double duplicate_rel_tol = 1e-12;
+  /// How many human-readable problems to keep.
+  int max_problems = 20;
+};
+
+struct ValidationReport {
+  bool valid = false;
+  std::size_t n_points = 0, n_solid = 0, n_interface = 0;
+
+  std::size_t bad_elements = 0;          ///< wrong dimension, wrong node count or node out of range
+  std::size_t inverted = 0;              ///< a corner Jacobian (tri/tet: signed measure) <= 0
+  std::size_t nonconforming_facets = 0;  ///< facets used 3+ times or twice in the same orientation
+  std::size_t hanging_nodes = 0;         ///< distinct nodes on the interior of another element's edge/facet
+  std::size_t interface_missing = 0;     ///< boundary facets of the solid with no interface element
+  std::size_t interface_extra = 0;       ///< interface elements that are not a boundary facet (or repeat one)
+  std::size_t interface_reversed = 0;    ///< interface elements oriented against the outward normal
+  std::size_t interface_mismatch = 0;    ///< missing + extra + reversed
+  std::size_t unused_nodes = 0;
+  std::size_t duplicate_nodes = 0;       ///< nodes coinciding with an earlier node
+  std::size_t off_boundary_nodes = 0;    ///< interface nodes farther than the tolerance (with a callback)
+  std::size_t attribute_mismatch = 0;    ///< level / from_boundary_cell sized neither 0 nor n_solid
+  double max_boundary_distance = 0.0;
+
+  long euler = 0;  ///< of the solid elements
+  std::optional<long> expected_euler;
+
+  /// The first max_problems problems, with element ids and coordinates.
+  std::vector<std::string> problems;
+  std::size_t n_problems = 0;  ///< all problems, including those not kept
+
+  /// One line per nonzero count, then the problems.
+  std::string summary() const;
+};
+
+template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});
+template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});
+
+/// Euler characteristic of the solid elements alone: V - E + F (2D), V - E + F - C (3D),
+/// V counting only the nodes the solid uses.
+template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh);
+
+}  // namespace febemesh
