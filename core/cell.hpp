@@ -2,6 +2,7 @@
 // A cell of the tree: integer anchor on a fixed lattice plus a level (STYLE.md §4, p4est quadrants).
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -26,8 +27,12 @@ template <int Dim> struct Cell {
   friend bool operator!=(const Cell& a, const Cell& b) { return !(a == b); }
 };
 
-/// A lattice point (cell corner) in finest-level units.
-template <int Dim> using LatticePoint = std::array<std::uint32_t, Dim>;
+/// A lattice point (cell corner) in finest-level units. The size is written std::size_t(Dim) so
+/// that Dim is deduced from the other arguments (a cell, a tree) and never from the array, whose
+/// size type differs from int and would make calls like locate(tree, point) fail to deduce.
+template <int Dim> using LatticePoint = std::array<std::uint32_t, std::size_t(Dim)>;
+/// A direction in {-1,0,1}^Dim (same deduction note as LatticePoint).
+template <int Dim> using Direction = std::array<int, std::size_t(Dim)>;
 
 /// Side of `c` in lattice units.
 template <int Dim> std::uint32_t length(const Cell<Dim>& c);
@@ -57,12 +62,83 @@ template <int Dim> bool is_ancestor_ref(const Cell<Dim>& a, const Cell<Dim>& d);
 /// Same-size neighbour across facet f (face_axis/face_side); false when it leaves the root.
 template <int Dim> bool face_neighbour(const Cell<Dim>& c, int f, Cell<Dim>& out);
 /// Same-size neighbour at integer offset `dir` in {-1,0,1}^Dim (not all 0); false outside the root.
-template <int Dim> bool neighbour(const Cell<Dim>& c, const std::array<int, Dim>& dir, Cell<Dim>& out);
+template <int Dim> bool neighbour(const Cell<Dim>& c, const Direction<Dim>& dir, Cell<Dim>& out);
 
 /// Corner k of the cell as a lattice point (bit d of k = upper along d).
 template <int Dim> LatticePoint<Dim> corner(const Cell<Dim>& c, int k);
 
 /// Lattice volume (length^Dim) as a double, exact up to 2^53.
 template <int Dim> double lattice_volume(const Cell<Dim>& c);
+
+// ---- additions: exact volumes, reference twins and lattice-point keys -------------------------
+
+/// Lattice volume length^Dim as an exact integer (the root is 2^56 in 2D, 2^60 in 3D). In a
+/// complete linear tree the next leaf's Morton key is morton_key(c) + volume_units(c).
+template <int Dim> std::uint64_t volume_units(const Cell<Dim>& c);
+/// Slow twin of morton_key: interleaves the anchor bit by bit (axis d -> bit Dim*k + d).
+template <int Dim> std::uint64_t morton_key_ref(const Cell<Dim>& c);
+/// Cell whose anchor has Morton key `key` at `level` (inverse of morton_key).
+template <int Dim> Cell<Dim> cell_from_key(std::uint64_t key, int level);
+/// Morton key of a lattice point; coordinates may equal root_length (upper root faces).
+template <int Dim> std::uint64_t point_key(const LatticePoint<Dim>& p);
+template <int Dim> LatticePoint<Dim> point_from_key(std::uint64_t key);
+/// Is lattice point p a corner of c, and does it lie in the closed lattice box of c.
+template <int Dim> bool is_corner(const Cell<Dim>& c, const LatticePoint<Dim>& p);
+template <int Dim> bool touches(const Cell<Dim>& c, const LatticePoint<Dim>& p);
+
+namespace detail {
+// Bit dilation for Morton keys (magic-number spreads). Inline because the tree's hot loops
+// (refinement, balance, location) call them millions of times.
+inline std::uint64_t spread_bits2(std::uint64_t x) {
+  x &= 0xffffffffULL;
+  x = (x | (x << 16)) & 0x0000ffff0000ffffULL;
+  x = (x | (x << 8)) & 0x00ff00ff00ff00ffULL;
+  x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0fULL;
+  x = (x | (x << 2)) & 0x3333333333333333ULL;
+  x = (x | (x << 1)) & 0x5555555555555555ULL;
+  return x;
+}
+inline std::uint32_t compact_bits2(std::uint64_t x) {
+  x &= 0x5555555555555555ULL;
+  x = (x | (x >> 1)) & 0x3333333333333333ULL;
+  x = (x | (x >> 2)) & 0x0f0f0f0f0f0f0f0fULL;
+  x = (x | (x >> 4)) & 0x00ff00ff00ff00ffULL;
+  x = (x | (x >> 8)) & 0x0000ffff0000ffffULL;
+  x = (x | (x >> 16)) & 0x00000000ffffffffULL;
+  return std::uint32_t(x);
+}
+inline std::uint64_t spread_bits3(std::uint64_t x) {  // 21 bits
+  x &= 0x1fffffULL;
+  x = (x | (x << 32)) & 0x1f00000000ffffULL;
+  x = (x | (x << 16)) & 0x1f0000ff0000ffULL;
+  x = (x | (x << 8)) & 0x100f00f00f00f00fULL;
+  x = (x | (x << 4)) & 0x10c30c30c30c30c3ULL;
+  x = (x | (x << 2)) & 0x1249249249249249ULL;
+  return x;
+}
+inline std::uint32_t compact_bits3(std::uint64_t x) {
+  x &= 0x1249249249249249ULL;
+  x = (x | (x >> 2)) & 0x10c30c30c30c30c3ULL;
+  x = (x | (x >> 4)) & 0x100f00f00f00f00fULL;
+  x = (x | (x >> 8)) & 0x1f0000ff0000ffULL;
+  x = (x | (x >> 16)) & 0x1f00000000ffffULL;
+  x = (x | (x >> 32)) & 0x1fffffULL;
+  return std::uint32_t(x);
+}
+template <int Dim> inline std::uint64_t interleave(const std::array<std::uint32_t, Dim>& a) {
+  if constexpr (Dim == 2) {
+    return spread_bits2(a[0]) | (spread_bits2(a[1]) << 1);
+  } else {
+    return spread_bits3(a[0]) | (spread_bits3(a[1]) << 1) | (spread_bits3(a[2]) << 2);
+  }
+}
+template <int Dim> inline std::array<std::uint32_t, Dim> deinterleave(std::uint64_t k) {
+  if constexpr (Dim == 2) {
+    return {compact_bits2(k), compact_bits2(k >> 1)};
+  } else {
+    return {compact_bits3(k), compact_bits3(k >> 1), compact_bits3(k >> 2)};
+  }
+}
+}  // namespace detail
 
 }  // namespace febemesh

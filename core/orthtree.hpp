@@ -39,6 +39,10 @@ template <int Dim> class Orthtree {
   std::vector<Cell<Dim>> leaves_;
 };
 
+/// The smallest cube with lower corner domain.lo enclosing `domain` (the root of Orthtree(domain)).
+/// Throws InputError for an empty, degenerate or non-finite domain.
+template <int Dim> Box<Dim> root_cube(const Box<Dim>& domain);
+
 /// Real box of a cell, and real position of a lattice point.
 template <int Dim> Box<Dim> geometry(const Orthtree<Dim>& t, const Cell<Dim>& c);
 template <int Dim> Point<Dim> position(const Orthtree<Dim>& t, const LatticePoint<Dim>& p);

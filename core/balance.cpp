@@ -1,0 +1,166 @@
+// 2:1 balance (the paper's one-level-difference rule) in O(n log n), without repeated sweeps.
+//
+// Work on the set I of internal (split) cells of the balanced tree. The tree is balanced iff for
+// every internal cell p, each same-size neighbour q of p (across facets, or across facets, edges
+// and corners) is itself a cell of the tree, i.e. parent(q) is internal: otherwise a child of p
+// touches a leaf two levels coarser. I must contain the strict ancestors of the input leaves, and
+// the rule only adds cells one level coarser than the cell that asks. So the smallest admissible I
+// (and with it the coarsest balanced refinement) is the closure computed level by level, finest
+// first, each level sorted and deduplicated once. The leaves are then the children of internal
+// cells that are not internal, emitted in Morton order by one depth-first walk.
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "core/orthtree.hpp"
+
+namespace febemesh {
+namespace {
+
+/// Key offset of one step along axis d at `level`, and a mask of axis d's bits.
+template <int Dim> constexpr std::uint64_t axis_mask(int d) {
+  std::uint64_t m = 0;
+  for (int b = 0; b < max_level<Dim>; ++b) m |= std::uint64_t(1) << (Dim * b + d);
+  return m;
+}
+
+/// Same-level neighbour of the cell with Morton key `key` at `level`, moved by `dir` (entries in
+/// {-1, 0, 1}), computed on the dilated key directly; false when it leaves the root.
+template <int Dim>
+inline bool neighbour_key(std::uint64_t key, int level, const int* dir, std::uint64_t& out) {
+  const int shift = Dim * (max_level<Dim> - level);
+  std::uint64_t result = 0;
+  for (int d = 0; d < Dim; ++d) {
+    const std::uint64_t mask = axis_mask<Dim>(d);
+    std::uint64_t x = key & mask;
+    const std::uint64_t step = std::uint64_t(1) << (shift + d);
+    if (dir[d] > 0) {
+      // Dilated addition: set the other axes' bits so that carries propagate through them.
+      x = ((x | ~mask) + step) & mask;
+      if (x == 0) return false;  // wrapped past the upper root face
+    } else if (dir[d] < 0) {
+      if (x == 0) return false;
+      x = (x - step) & mask;
+    }
+    result |= x;
+  }
+  out = result;
+  return true;
+}
+
+template <int Dim> struct Directions {
+  /// Does the balance kind look along directions that move on this subset of axes (bitmask)?
+  /// Face: single axes only; Full: any non-empty subset (edges and corners too).
+  static bool wanted(int axes, BalanceKind kind) {
+    return kind == BalanceKind::Full || (axes & (axes - 1)) == 0;
+  }
+};
+
+}  // namespace
+
+template <int Dim> Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind) {
+  const auto& leaves = t.leaves();
+  int deepest = 0;
+  for (const auto& c : leaves) deepest = std::max(deepest, int(c.level));
+  if (deepest <= 1) return t;  // children of the root are always balanced
+
+  // internal[L]: sorted Morton keys of internal cells at level L. Parents of the leaves come out
+  // sorted from the Morton-ordered leaves (masking low bits is monotone).
+  std::vector<std::vector<std::uint64_t>> internal(deepest);
+  for (const auto& c : leaves) {
+    if (c.level == 0) continue;
+    const int pl = c.level - 1;
+    const std::uint64_t pk = morton_key(c) & ~(volume_units(Cell<Dim>{{}, std::uint8_t(pl)}) - 1);
+    auto& v = internal[pl];
+    if (v.empty() || v.back() != pk) v.push_back(pk);
+  }
+  MESH_ASSERT(std::all_of(internal.begin(), internal.end(),
+                          [](const auto& v) { return std::is_sorted(v.begin(), v.end()); }),
+              "leaves are not in Morton order");
+
+  std::vector<std::uint64_t> candidates, merged;
+  for (int level = deepest - 1; level >= 1; --level) {
+    const auto& here = internal[level];
+    const int pl = level - 1;
+    const std::uint64_t parent_mask = ~(volume_units(Cell<Dim>{{}, std::uint8_t(pl)}) - 1);
+    const int child_shift = Dim * (max_level<Dim> - level);
+    candidates.clear();
+    // One sibling group at a time: the union of outward sides of its internal children says which
+    // neighbours of the parent are required.
+    for (std::size_t i = 0; i < here.size();) {
+      const std::uint64_t pk = here[i] & parent_mask;
+      unsigned present = 0;  // bit k: child k of the parent is internal
+      for (; i < here.size() && (here[i] & parent_mask) == pk; ++i) {
+        present |= 1u << ((here[i] >> child_shift) & (Cube<Dim>::n_children - 1));
+      }
+      candidates.push_back(pk);
+      // A direction is a subset of axes plus a side on each; it leaves the parent only from a
+      // child lying on that side along every axis of the subset.
+      for (int axes = 1; axes < Cube<Dim>::n_children; ++axes) {
+        if (!Directions<Dim>::wanted(axes, kind)) continue;
+        for (int signs = 0; signs < Cube<Dim>::n_children; ++signs) {
+          if ((signs & ~axes) != 0) continue;
+          bool reachable = false;
+          for (int k = 0; k < Cube<Dim>::n_children; ++k) {
+            if (((present >> k) & 1u) && (k & axes) == signs) reachable = true;
+          }
+          if (!reachable) continue;
+          int dir[Dim];
+          for (int d = 0; d < Dim; ++d) dir[d] = ((axes >> d) & 1) ? (((signs >> d) & 1) ? 1 : -1) : 0;
+          std::uint64_t nk;
+          if (neighbour_key<Dim>(pk, pl, dir, nk)) candidates.push_back(nk);
+        }
+      }
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    auto& below = internal[pl];
+    merged.clear();
+    merged.reserve(candidates.size() + below.size());
+    std::set_union(candidates.begin(), candidates.end(), below.begin(), below.end(),
+                   std::back_inserter(merged));
+    below.swap(merged);
+  }
+
+  // Children of internal cells that are not internal are the leaves; a depth-first walk meets
+  // each level's internal cells in increasing key order, so one cursor per level suffices.
+  std::size_t n_internal = 0;
+  for (const auto& v : internal) n_internal += v.size();
+  std::vector<Cell<Dim>> out;
+  out.reserve(1 + n_internal * (Cube<Dim>::n_children - 1));
+  std::vector<std::size_t> cursor(internal.size() + 1, 0);
+  internal.emplace_back();  // no internal cells at the deepest level
+  struct Walker {
+    const std::vector<std::vector<std::uint64_t>>& internal;
+    std::vector<std::size_t>& cursor;
+    std::vector<Cell<Dim>>& out;
+    void walk(const Cell<Dim>& p, std::uint64_t pkey) {
+      const int level = p.level + 1;
+      const std::uint32_t half = std::uint32_t(1) << (max_level<Dim> - level);
+      const int shift = Dim * (max_level<Dim> - level);
+      const auto& v = internal[level];
+      std::size_t& cur = cursor[level];
+      for (int i = 0; i < Cube<Dim>::n_children; ++i) {
+        Cell<Dim> ch;
+        ch.level = std::uint8_t(level);
+        for (int d = 0; d < Dim; ++d) ch.anchor[d] = p.anchor[d] + (((i >> d) & 1) ? half : 0);
+        const std::uint64_t ckey = pkey | (std::uint64_t(i) << shift);
+        if (cur < v.size() && v[cur] == ckey) {
+          ++cur;
+          walk(ch, ckey);
+        } else {
+          out.push_back(ch);
+        }
+      }
+    }
+  };
+  Walker{internal, cursor, out}.walk(Cell<Dim>{}, 0);
+  MESH_ASSERT(out.size() == 1 + n_internal * (Cube<Dim>::n_children - 1),
+              "balanced tree has " << out.size() << " leaves for " << n_internal << " internal cells");
+  return Orthtree<Dim>(t.root_box(), std::move(out));
+}
+
+template Orthtree<2> balance_2to1<2>(const Orthtree<2>&, BalanceKind);
+template Orthtree<3> balance_2to1<3>(const Orthtree<3>&, BalanceKind);
+
+}  // namespace febemesh
