@@ -63,4 +63,12 @@ Loop loop_from_beziers(std::vector<Bezier> pieces, const std::string& name, doub
 /// A polygon: every vertex a corner, every edge a straight cubic piece.
 Loop loop_from_polygon(const std::vector<P2>& vertices, const std::string& name);
 
+/// The control polygon of the closed uniform B-spline behind loop_from_bspline: corner points
+/// tripled (paper footnote). Point j of the result is the curve's control point for knot j.
+std::vector<P2> expand_corners(const std::vector<ControlPoint>& cps);
+
+/// Slow twin of loop_from_bspline: de Boor's algorithm on the expanded control polygon `q`
+/// (closed, uniform integer knots; segment i, t in [i, i+1], uses q[i-1..i+2]).
+P2 bspline_point_ref(const std::vector<P2>& q, double t);
+
 }  // namespace febemesh::dim2
