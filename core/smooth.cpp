@@ -1,0 +1,126 @@
+// Node graphs in CSR form; the guard re-evaluates only the elements incident to the moved node.
+
+#include "core/smooth.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include "core/error.hpp"
+#include "core/mesh_topology.hpp"
+#include "core/quality.hpp"
+
+namespace febemesh {
+
+namespace {
+
+/// Compressed adjacency lists: the neighbours of node v are item[start[v] .. start[v+1]).
+struct Csr {
+  std::vector<std::int32_t> start, item;
+  std::span<const std::int32_t> of(std::int32_t v) const {
+    return {item.data() + start[v], static_cast<std::size_t>(start[v + 1] - start[v])};
+  }
+};
+
+Csr build_csr(std::size_t n, const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs) {
+  Csr g;
+  g.start.assign(n + 1, 0);
+  for (const auto& [a, b] : pairs) {
+    (void)b;
+    ++g.start[a + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
+  g.item.resize(pairs.size());
+  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (const auto& [a, b] : pairs) g.item[fill[a]++] = b;
+  return g;
+}
+
+std::vector<std::pair<std::int32_t, std::int32_t>> both_ways(const std::vector<std::array<VertexId, 2>>& edges) {
+  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
+  pairs.reserve(2 * edges.size());
+  for (const auto& [a, b] : edges) {
+    pairs.emplace_back(a.v, b.v);
+    pairs.emplace_back(b.v, a.v);
+  }
+  return pairs;
+}
+
+}  // namespace
+
+template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>& options) {
+  const std::size_t n = mesh.points.size();
+  MESH_ASSERT(options.fixed.empty() || options.fixed.size() == n, "fixed has " << options.fixed.size() << " entries");
+  SmoothStats stats;
+  const std::vector<double> q0 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
+  stats.min_quality_before = q0.empty() ? 0.0 : *std::min_element(q0.begin(), q0.end());
+
+  const Csr neighbours = build_csr(n, both_ways(unique_edges(mesh.solid)));
+  Elements boundary;
+  std::vector<std::uint8_t> on_boundary(n, 0);
+  for (const BoundaryFacet& b : boundary_facets(mesh.solid)) {
+    boundary.add(b.facet.type, b.facet.node.data(), b.facet.n);
+    for (int i = 0; i < b.facet.n; ++i) on_boundary[b.facet.node[i].v] = 1;
+  }
+  const Csr boundary_neighbours = build_csr(n, both_ways(unique_edges(boundary)));
+  std::vector<std::pair<std::int32_t, std::int32_t>> node_elem;
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int i = 0; i < mesh.solid.n_nodes_of(id); ++i) node_elem.emplace_back(mesh.solid.nodes(id)[i].v, id.v);
+  }
+  const Csr incident = build_csr(n, node_elem);
+
+  auto element_state = [&](std::int32_t e) {
+    const auto ep = element_points<Dim>(mesh.solid, ElemId{e}, mesh.points);
+    const ElemType t = mesh.solid.type[e];
+    return std::pair{min_corner_jacobian<Dim>(t, ep.span()) > 0.0, scaled_jacobian<Dim>(t, ep.span())};
+  };
+
+  std::vector<std::pair<bool, double>> before;
+  for (int it = 0; it < options.n_iterations; ++it) {
+    ++stats.iterations;
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!options.fixed.empty() && options.fixed[v]) continue;
+      const bool slides = on_boundary[v] != 0;
+      if (slides && !options.project) continue;
+      const auto nbrs = slides ? boundary_neighbours.of(static_cast<std::int32_t>(v)) : neighbours.of(static_cast<std::int32_t>(v));
+      const auto elems = incident.of(static_cast<std::int32_t>(v));
+      if (nbrs.empty() || elems.empty()) continue;
+      Point<Dim> target = Point<Dim>::Zero();
+      for (const auto w : nbrs) target += mesh.points[w];
+      target /= static_cast<double>(nbrs.size());
+      if (slides) target = options.project(target);
+      if (target == mesh.points[v]) continue;
+
+      before.clear();
+      double old_min = std::numeric_limits<double>::infinity();
+      for (const auto e : elems) {
+        before.push_back(element_state(e));
+        old_min = std::min(old_min, before.back().second);
+      }
+      const Point<Dim> saved = mesh.points[v];
+      mesh.points[v] = target;
+      bool accept = true;
+      double new_min = std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < elems.size() && accept; ++k) {
+        const auto [positive, q] = element_state(elems[k]);
+        accept = positive || !before[k].first;
+        new_min = std::min(new_min, q);
+      }
+      accept = accept && new_min >= old_min;
+      if (accept) {
+        ++stats.moves_accepted;
+      } else {
+        mesh.points[v] = saved;
+        ++stats.moves_rejected;
+      }
+    }
+  }
+  const std::vector<double> q1 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
+  stats.min_quality_after = q1.empty() ? 0.0 : *std::min_element(q1.begin(), q1.end());
+  return stats;
+}
+
+template SmoothStats smooth<2>(Mesh<2>&, const SmoothOptions<2>&);
+template SmoothStats smooth<3>(Mesh<3>&, const SmoothOptions<3>&);
+
+}  // namespace febemesh

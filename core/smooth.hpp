@@ -1,0 +1,37 @@
+#pragma once
+// Guarded Laplacian smoothing (paper, step 4; DESIGN.md pipeline step 4), generic over Dim.
+// Gauss-Seidel sweeps in node order: an interior node moves to the centroid of its neighbours
+// along element edges. A move is accepted only if no incident element inverts and the minimum
+// scaled Jacobian of the incident elements does not drop. Boundary nodes (nodes of boundary
+// facets of the solid) stay put unless `project` is given: then they move to the centroid of
+// their neighbours along the boundary and are projected back, under the same guard.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/mesh.hpp"
+
+namespace febemesh {
+
+template <int Dim> struct SmoothOptions {
+  int n_iterations = 4;  ///< the paper uses 4
+  /// Per node, 1 = never moves (e.g. corners). Empty = none fixed explicitly.
+  std::vector<std::uint8_t> fixed;
+  /// Maps a point near the boundary onto it; when set, boundary nodes may slide.
+  std::function<Point<Dim>(const Point<Dim>&)> project;
+};
+
+struct SmoothStats {
+  int iterations = 0;
+  std::size_t moves_accepted = 0;
+  std::size_t moves_rejected = 0;
+  double min_quality_before = 0.0;  ///< min scaled Jacobian of the solid elements
+  double min_quality_after = 0.0;
+};
+
+/// Moves mesh.points in place; the connectivity is unchanged.
+template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>& options = {});
+
+}  // namespace febemesh
