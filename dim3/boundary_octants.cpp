@@ -1,0 +1,400 @@
+#include "dim3/boundary_octants.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <tuple>
+
+#include "core/cube_faces.hpp"
+#include "core/error.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+using LP = LatticePoint<3>;
+
+LP midpoint(const LP& a, const LP& b) { return {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}; }
+
+/// The leaf of each of the eight octants around lattice point p (bit d set = upper side along
+/// d), or no_leaf outside the root.
+std::array<std::size_t, 8> octants_around(const Orthtree<3>& t, const LP& p) {
+  std::array<std::size_t, 8> out;
+  for (int o = 0; o < 8; ++o) {
+    LP q = p;
+    bool inside = true;
+    for (int d = 0; d < 3; ++d) {
+      if (corner_is_upper(o, d)) {
+        inside = inside && q[d] < root_length<3>;
+      } else {
+        inside = inside && q[d] > 0;
+        if (inside) q[d] -= 1;
+      }
+    }
+    out[o] = inside ? locate(t, q) : no_leaf;
+  }
+  return out;
+}
+
+/// Face-connected components of the octants in `mask` within the 2x2x2 block (octants are
+/// face-adjacent when their indices differ in one bit). comp[o] = component or -1.
+int components(unsigned mask, std::array<int, 8>& comp) {
+  comp.fill(-1);
+  int n = 0;
+  for (int s = 0; s < 8; ++s) {
+    if (!((mask >> s) & 1) || comp[s] >= 0) continue;
+    std::array<int, 8> stack{};
+    int top = 0;
+    stack[top++] = s;
+    comp[s] = n;
+    while (top > 0) {
+      const int o = stack[--top];
+      for (int d = 0; d < 3; ++d) {
+        const int nb = o ^ (1 << d);
+        if (((mask >> nb) & 1) && comp[nb] < 0) {
+          comp[nb] = n;
+          stack[top++] = nb;
+        }
+      }
+    }
+    ++n;
+  }
+  return n;
+}
+
+double face_size(const Orthtree<3>& t, const Cell<3>& c) { return length(c) * t.unit(); }
+
+}  // namespace
+
+std::vector<std::int32_t> face_ring(const LatticeNodes<3>& nodes, const Cell<3>& cell, int face,
+                                    std::array<std::uint8_t, 4>& corner_slot) {
+  std::vector<std::int32_t> ring;
+  const auto& fc = FaceCorners<3>::corners[face];
+  for (int k = 0; k < 4; ++k) {
+    const LP a = corner(cell, fc[k]), b = corner(cell, fc[(k + 1) % 4]);
+    corner_slot[k] = static_cast<std::uint8_t>(ring.size());
+    ring.push_back(nodes.find(a));
+    MESH_ASSERT(ring.back() >= 0, "free face corner is not a lattice node");
+    if (length(cell) >= 2) {
+      const std::int32_t m = nodes.find(midpoint(a, b));
+      if (m >= 0) ring.push_back(m);
+    }
+  }
+  return ring;
+}
+
+std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
+  std::size_t removed = 0;
+  for (int pass = 0; pass < 64; ++pass) {
+    std::map<std::uint64_t, LP> points;  // ordered by key: deterministic
+    for (const FreeFacet<3>& f : free_facets(t, in))
+      for (const LP& p : f.corners()) points.emplace(point_key<3>(p), p);
+    std::vector<std::size_t> drop;
+    for (const auto& [key, p] : points) {
+      const auto around = octants_around(t, p);
+      unsigned kept = 0;
+      for (int o = 0; o < 8; ++o)
+        if (around[o] != no_leaf && in[around[o]]) kept |= 1u << o;
+      std::array<int, 8> ck{}, cu{};
+      const int nk = components(kept, ck);
+      const int nu = components(~kept & 0xffu, cu);
+      if (nk > 1) {
+        // Keep the largest kept component (ties: the one with the lowest octant), drop the rest.
+        std::array<int, 8> size{};
+        for (int o = 0; o < 8; ++o)
+          if (ck[o] >= 0) ++size[ck[o]];
+        int best = 0;
+        for (int c = 1; c < nk; ++c)
+          if (size[c] > size[best]) best = c;
+        for (int o = 0; o < 8; ++o)
+          if (ck[o] >= 0 && ck[o] != best) drop.push_back(around[o]);
+      } else if (nu > 1) {
+        // Open a passage between the unkept components: drop the first kept octant touching two.
+        for (int o = 0; o < 8; ++o) {
+          if (ck[o] < 0) continue;
+          int first = -1;
+          bool two = false;
+          for (int d = 0; d < 3; ++d) {
+            const int c = cu[o ^ (1 << d)];
+            if (c < 0) continue;
+            if (first < 0) first = c;
+            else if (c != first) two = true;
+          }
+          if (two) {
+            drop.push_back(around[o]);
+            break;
+          }
+        }
+      }
+    }
+    std::sort(drop.begin(), drop.end());
+    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
+    std::size_t n = 0;
+    for (std::size_t i : drop) {
+      if (i != no_leaf && in[i]) {
+        in[i] = 0;
+        ++n;
+      }
+    }
+    removed += n;
+    if (n == 0) break;
+  }
+  return removed;
+}
+
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction) {
+  if (fraction <= 0) return 0;
+  std::size_t removed = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    std::vector<std::size_t> drop;
+    for (const FreeFacet<3>& f : free_facets(t, in)) {
+      const auto c = f.corners();
+      const double h = face_size(t, f.cell);
+      P3 centre = P3::Zero();
+      double d = std::numeric_limits<double>::infinity();
+      for (const LP& p : c) {
+        const P3 x = position(t, p);
+        centre += 0.25 * x;
+        d = std::min(d, s.closest_point(x).distance);
+      }
+      d = std::min(d, s.closest_point(centre).distance);
+      if (d < fraction * h) drop.push_back(f.leaf);
+    }
+    std::sort(drop.begin(), drop.end());
+    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
+    if (drop.empty()) break;
+    for (std::size_t i : drop) in[i] = 0;
+    removed += drop.size();
+  }
+  return removed;
+}
+
+namespace {
+
+struct Projector {
+  const Orthtree<3>& tree;
+  const Flags& in;
+  const SurfaceBoundary& surface;
+
+  /// The segment from q to a surface point p enters no interior octant and does not cross the
+  /// surface before reaching p.
+  bool admissible(const P3& q, const P3& p) const {
+    if (segment_enters_kept(tree, in, q, p)) return false;
+    const P3 short_end = q + (1.0 - 1e-7) * (p - q);
+    return !surface.segment_crosses(q, short_end);
+  }
+};
+
+/// Feature line segments bucketed on a uniform grid, for "nearest feature line point" queries.
+class FeatureGrid {
+ public:
+  FeatureGrid(const Features& f, double cell) : f_(f), cell_(cell) {
+    for (std::int32_t l = 0; l < static_cast<std::int32_t>(f.lines().size()); ++l) {
+      const FeatureLine& line = f.lines()[l];
+      for (std::int32_t k = 0; k + 1 < static_cast<std::int32_t>(line.points.size()); ++k) {
+        Box<3> b = Box<3>::empty();
+        b.expand(line.points[k]);
+        b.expand(line.points[k + 1]);
+        const auto lo = key(b.lo), hi = key(b.hi);
+        for (long x = lo[0]; x <= hi[0]; ++x)
+          for (long y = lo[1]; y <= hi[1]; ++y)
+            for (long z = lo[2]; z <= hi[2]; ++z) grid_[{x, y, z}].push_back({l, k});
+      }
+    }
+  }
+  /// Nearest point on a feature line within about one grid cell of p (distance inf if none).
+  Features::LinePoint nearest(const P3& p, std::int32_t& line_out) const {
+    Features::LinePoint best;
+    best.distance = std::numeric_limits<double>::infinity();
+    line_out = -1;
+    const auto c = key(p);
+    for (long x = c[0] - 1; x <= c[0] + 1; ++x)
+      for (long y = c[1] - 1; y <= c[1] + 1; ++y)
+        for (long z = c[2] - 1; z <= c[2] + 1; ++z) {
+          const auto it = grid_.find({x, y, z});
+          if (it == grid_.end()) continue;
+          for (const auto& [l, k] : it->second) {
+            const FeatureLine& line = f_.lines()[l];
+            const P3 a = line.points[k], b = line.points[k + 1];
+            const P3 ab = b - a;
+            const double len2 = ab.squaredNorm();
+            const double tt = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+            const P3 q = a + tt * ab;
+            const double d = (q - p).norm();
+            if (d < best.distance) {
+              best.point = q;
+              best.distance = d;
+              best.segment = k;
+              best.t = tt;
+              line_out = l;
+            }
+          }
+        }
+    return best;
+  }
+
+ private:
+  std::array<long, 3> key(const P3& p) const {
+    return {static_cast<long>(std::floor(p[0] / cell_)), static_cast<long>(std::floor(p[1] / cell_)),
+            static_cast<long>(std::floor(p[2] / cell_))};
+  }
+  const Features& f_;
+  double cell_;
+  std::map<std::array<long, 3>, std::vector<std::pair<std::int32_t, std::int32_t>>> grid_;
+};
+
+}  // namespace
+
+OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s,
+                                         const BoundaryOctantOptions& opt) {
+  OctantComplexResult res;
+  OctantComplex& oc = res.complex;
+  oc.lattice = lattice_nodes(t, &in);
+  const std::int32_t n_lat = oc.n_lattice();
+  oc.points.reserve(n_lat);
+  for (const LP& p : oc.lattice.points) oc.points.push_back(position(t, p));
+  oc.where.assign(n_lat, BoundaryLocation{});
+  oc.projection.assign(n_lat, -1);
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    if (in[i]) oc.interior.push_back(i);
+
+  const std::vector<FreeFacet<3>> facets = free_facets(t, in);
+  res.stats.n_free_faces = facets.size();
+  std::vector<double> node_h(n_lat, std::numeric_limits<double>::infinity());
+  for (const FreeFacet<3>& f : facets) {
+    BoundaryOctant b;
+    b.leaf = f.leaf;
+    b.cell = f.cell;
+    b.face = f.face;
+    b.ring = face_ring(oc.lattice, f.cell, f.face, b.corner_slot);
+    const double h = face_size(t, f.cell);
+    for (std::int32_t q : b.ring) node_h[q] = std::min(node_h[q], h);
+    oc.boundary.push_back(std::move(b));
+  }
+
+  // Project every face node (closest point, then the next local minima; paper eq. 1 with the
+  // crossing rule). Equal projections share one surface node.
+  Projector proj{t, in, s};
+  std::map<std::tuple<double, double, double>, std::int32_t> by_point;
+  std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
+  for (std::int32_t q = 0; q < n_lat; ++q) {
+    if (!std::isfinite(node_h[q])) continue;
+    ++res.stats.n_face_nodes;
+    const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);
+    std::size_t pick = cands.size();
+    for (std::size_t k = 0; k < cands.size() && pick == cands.size(); ++k)
+      if (proj.admissible(oc.points[q], cands[k].point)) pick = k;
+    if (pick == cands.size()) {
+      res.problems.push_back({oc.points[q], "no admissible projection onto the surface"});
+      continue;
+    }
+    if (pick > 0) ++res.stats.n_next_normal;
+    const ClosestPoint<3>& cp = cands[pick];
+    const auto key = std::make_tuple(cp.point[0], cp.point[1], cp.point[2]);
+    const auto it = by_point.find(key);
+    if (it != by_point.end()) {
+      oc.projection[q] = it->second;
+      sources[it->second - n_lat].push_back(q);
+      ++res.stats.n_shared_projections;
+      continue;
+    }
+    const std::int32_t id = static_cast<std::int32_t>(oc.points.size());
+    oc.points.push_back(cp.point);
+    oc.where.push_back(cp.where);
+    by_point.emplace(key, id);
+    sources.push_back({q});
+    oc.projection[q] = id;
+  }
+  res.stats.n_surface_nodes = sources.size();
+  oc.snapped.assign(oc.points.size(), 0);
+  oc.unsnapped = oc.points;
+  if (!res.problems.empty() || !opt.snap_features) return res;
+
+  const auto surface_h = [&](std::int32_t p) {
+    double h = std::numeric_limits<double>::infinity();
+    for (std::int32_t q : sources[p - n_lat]) h = std::min(h, node_h[q]);
+    return h;
+  };
+  const auto admissible_from_all = [&](std::int32_t p, const P3& target) {
+    for (std::int32_t q : sources[p - n_lat])
+      if (!proj.admissible(oc.points[q], target)) return false;
+    return true;
+  };
+
+  // Corners: the nearest surface node within corner_radius face sizes moves onto the corner.
+  const Features& feat = s.features();
+  const std::int32_t n_pts = static_cast<std::int32_t>(oc.points.size());
+  for (std::int32_t c = 0; c < feat.n_corners(); ++c) {
+    const P3& cp = feat.corner_points()[c];
+    std::int32_t best = -1;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (std::int32_t p = n_lat; p < n_pts; ++p) {
+      const double d = (oc.points[p] - cp).norm();
+      if (d < best_d && oc.snapped[p] != 2) best_d = d, best = p;
+    }
+    if (best < 0 || best_d > opt.corner_radius * surface_h(best) || !admissible_from_all(best, cp)) {
+      ++res.stats.n_corners_missed;
+      continue;
+    }
+    oc.points[best] = cp;
+    oc.where[best].kind = BoundaryLocation::Kind::Corner;
+    oc.where[best].feature = c;
+    const std::int32_t v = feat.corners()[c];
+    const std::int32_t tri = s.surface().vertex_triangles(v).front();
+    const Triangle& tv = s.surface().triangle(tri);
+    oc.where[best].patch = tri;
+    oc.where[best].param[0] = tv[1] == v ? 1.0 : 0.0;
+    oc.where[best].param[1] = tv[2] == v ? 1.0 : 0.0;
+    oc.snapped[best] = 2;
+    ++res.stats.n_corners_snapped;
+  }
+
+  // Feature lines: nodes within edge_radius face sizes of a line move onto it, unless a node
+  // already snapped nearby (both sides of a sharp edge must not collapse onto one point).
+  if (feat.n_feature_edges() > 0) {
+    double h_med = 0.0;
+    {
+      std::vector<double> hs;
+      for (std::int32_t p = n_lat; p < n_pts; ++p) hs.push_back(surface_h(p));
+      std::nth_element(hs.begin(), hs.begin() + hs.size() / 2, hs.end());
+      h_med = hs.empty() ? 1.0 : hs[hs.size() / 2];
+    }
+    const FeatureGrid grid(feat, std::max(h_med, 1e-300));
+    std::vector<std::pair<double, std::int32_t>> order;  // nearest first
+    std::vector<Features::LinePoint> hit(oc.points.size());
+    for (std::int32_t p = n_lat; p < n_pts; ++p) {
+      if (oc.snapped[p]) continue;
+      std::int32_t line = -1;
+      hit[p] = grid.nearest(oc.points[p], line);
+      if (line >= 0 && hit[p].distance > 0 && hit[p].distance < opt.edge_radius * surface_h(p))
+        order.push_back({hit[p].distance, p});
+    }
+    std::sort(order.begin(), order.end());
+    // Snapped targets on a grid of spacing about a third of the face size, to keep snapped
+    // nodes apart.
+    std::vector<P3> taken;
+    for (std::int32_t p = n_lat; p < n_pts; ++p)
+      if (oc.snapped[p]) taken.push_back(oc.points[p]);
+    for (const auto& [d, p] : order) {
+      const P3 target = hit[p].point;
+      const double h = surface_h(p);
+      bool crowded = false;
+      for (const P3& x : taken)
+        if ((x - target).norm() < 0.3 * h) {
+          crowded = true;
+          break;
+        }
+      if (crowded || !admissible_from_all(p, target)) continue;
+      const ClosestPoint<3> on = s.closest_point(target);
+      oc.points[p] = target;
+      oc.where[p] = on.where;
+      oc.where[p].kind = BoundaryLocation::Kind::FeatureEdge;
+      oc.snapped[p] = 1;
+      taken.push_back(target);
+      ++res.stats.n_edge_snapped;
+    }
+  }
+  return res;
+}
+
+}  // namespace febemesh::dim3

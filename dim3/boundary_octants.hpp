@@ -1,0 +1,104 @@
+#pragma once
+// The octree extension of the paper's "Generation of boundary quadrants" (its conclusion): one
+// boundary octant between each free face of the interior octants and the surface, made of the
+// face and the projections of its nodes (corners and hanging edge midpoints), i.e. a hexahedron
+// Q1..Q4 P1..P4 whose sides are split at hanging midpoints.
+//
+// As in 2D the construction checks what it needs and reports the places where the tree is too
+// coarse instead of producing a broken mesh:
+// - the interior region must be a manifold: octants meeting only at an edge or a vertex are
+//   dropped (remove_pinches), and octants too close to the surface too (apply_buffer, against
+//   flat boundary octants);
+// - a projection segment must not enter an interior octant nor cross the surface: take the next
+//   local minimum of the distance, else report a Problem;
+// - projections landing on the same surface point share one node (degenerate octants become
+//   prisms, pyramids or tets in the templates);
+// - feature corners pull the nearest boundary node, then nodes near a feature line are
+//   projected onto it (the 3D version of pulling to corners).
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/free_facets.hpp"
+#include "core/orthtree.hpp"
+#include "dim3/surface_boundary.hpp"
+
+namespace febemesh::dim3 {
+
+/// A boundary octant: a free face of the interior octants and the projections of its nodes.
+struct BoundaryOctant {
+  std::size_t leaf = no_leaf;  ///< the interior octant behind the face
+  Cell<3> cell;                ///< the leaf, or its descendant for a sub-face (see FreeFacet)
+  int face = -1;               ///< face of `cell`
+  /// Face nodes counter-clockwise seen from outside the interior octant (FaceCorners<3> order),
+  /// hanging edge midpoints included; lattice node ids.
+  std::vector<std::int32_t> ring;
+  std::array<std::uint8_t, 4> corner_slot{};  ///< position in `ring` of each face corner
+};
+
+/// Interior octants plus boundary octants with shared nodes: what the templates work on.
+/// Nodes 0..n_lattice-1 are the lattice nodes of the interior octants (same ids as `lattice`),
+/// the others are surface nodes (projections).
+struct OctantComplex {
+  LatticeNodes<3> lattice;
+  std::vector<P3> points;
+  std::vector<BoundaryLocation> where;     ///< patch >= 0 for surface nodes
+  std::vector<std::int32_t> projection;    ///< per lattice node: its surface node, or -1
+  std::vector<std::size_t> interior;       ///< the interior leaves, ascending
+  std::vector<BoundaryOctant> boundary;
+  /// Per surface node (indexed like points): 0 plain, 1 on a feature line, 2 on a corner.
+  std::vector<std::uint8_t> snapped;
+  std::vector<P3> unsnapped;               ///< position before feature snapping
+
+  std::int32_t n_lattice() const { return static_cast<std::int32_t>(lattice.points.size()); }
+};
+
+struct BoundaryOctantStats {
+  std::size_t n_free_faces = 0;
+  std::size_t n_face_nodes = 0;      ///< lattice nodes on the free faces
+  std::size_t n_surface_nodes = 0;   ///< distinct projections
+  std::size_t n_shared_projections = 0;
+  std::size_t n_next_normal = 0;     ///< projections that took a further local minimum
+  std::size_t n_corners_snapped = 0;
+  std::size_t n_corners_missed = 0;
+  std::size_t n_edge_snapped = 0;
+};
+
+/// A place where the tree is too coarse for the construction, with the reason.
+struct Problem3 {
+  P3 where = P3::Zero();
+  std::string what;
+};
+
+struct OctantComplexResult {
+  OctantComplex complex;
+  BoundaryOctantStats stats;
+  std::vector<Problem3> problems;  ///< empty when the complex is complete
+};
+
+/// Drop interior octants so that the interior region is a manifold around every node of its
+/// boundary: around each free-face corner the kept and the unkept ones among the eight octants
+/// must each be face-connected. Returns how many octants were dropped.
+std::size_t remove_pinches(const Orthtree<3>& t, Flags& in);
+
+/// Drop interior octants whose free faces come nearer the surface than `fraction` of their size.
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction);
+
+struct BoundaryOctantOptions {
+  int max_normals = 4;               ///< local minima tried per node
+  bool snap_features = true;
+  double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes
+  double edge_radius = 0.35;         ///< project nodes within this many face sizes onto a feature line
+};
+
+OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s,
+                                         const BoundaryOctantOptions& opt = {});
+
+/// The ring of a free face: its corners in FaceCorners<3> order with the lattice nodes at edge
+/// midpoints in between; corner_slot receives each corner's position.
+std::vector<std::int32_t> face_ring(const LatticeNodes<3>& nodes, const Cell<3>& cell, int face,
+                                    std::array<std::uint8_t, 4>& corner_slot);
+
+}  // namespace febemesh::dim3

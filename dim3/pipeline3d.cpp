@@ -1,0 +1,197 @@
+#include "dim3/pipeline3d.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/quality.hpp"
+#include "core/smooth.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+class Stopwatch {
+ public:
+  explicit Stopwatch(std::vector<StageTime3>& out) : out_(out) {}
+  void lap(const std::string& name) {
+    const auto now = std::chrono::steady_clock::now();
+    out_.push_back({name, std::chrono::duration<double>(now - last_).count()});
+    last_ = now;
+  }
+
+ private:
+  std::vector<StageTime3>& out_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+Flags interior_flags(const std::vector<Side>& sides) {
+  Flags in(sides.size());
+  for (std::size_t i = 0; i < sides.size(); ++i) in[i] = sides[i] == Side::In ? 1 : 0;
+  return in;
+}
+
+/// Mark the leaves around each problem for one more subdivision; false when none can be.
+bool mark_around(const Orthtree<3>& t, const std::vector<Problem3>& problems, int max_level, Flags& flags) {
+  flags.assign(t.n_leaves(), 0);
+  bool any = false;
+  for (const Problem3& pr : problems) {
+    const std::size_t i = locate(t, pr.where);
+    const double h = t.unit() * length(t.leaf(i == no_leaf ? 0 : i));
+    Box<3> b;
+    b.lo = pr.where.array() - 1.5 * h;
+    b.hi = pr.where.array() + 1.5 * h;
+    for (std::size_t j : leaves_in_box(t, b)) {
+      if (t.leaf(j).level < max_level) {
+        flags[j] = 1;
+        any = true;
+      }
+    }
+  }
+  return any;
+}
+
+std::string describe(const std::vector<Problem3>& problems) {
+  std::ostringstream os;
+  os.precision(6);
+  const std::size_t shown = std::min<std::size_t>(problems.size(), 3);
+  for (std::size_t k = 0; k < shown; ++k)
+    os << (k ? "; " : "") << problems[k].what << " near (" << problems[k].where[0] << ", " << problems[k].where[1]
+       << ", " << problems[k].where[2] << ")";
+  if (problems.size() > shown) os << "; and " << problems.size() - shown << " more";
+  return os.str();
+}
+
+/// Solid elements that are inverted or flat (signed volume below 1e-12 of their edge cubed).
+std::vector<std::size_t> inverted_elements(const Mesh<3>& m) {
+  std::vector<std::size_t> out;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const auto pts = element_points<3>(m.solid, id, m.points);
+    double len = 0.0;
+    for (int a = 0; a < pts.n; ++a)
+      for (int b = a + 1; b < pts.n; ++b) len = std::max(len, (pts.p[a] - pts.p[b]).norm());
+    if (signed_measure<3>(m.solid.type[e], pts.span()) <= 1e-12 * len * len * len) out.push_back(e);
+  }
+  return out;
+}
+
+P3 centroid(const Mesh<3>& m, std::size_t e) {
+  const ElemId id{static_cast<std::int32_t>(e)};
+  const auto pts = element_points<3>(m.solid, id, m.points);
+  P3 c = P3::Zero();
+  for (int k = 0; k < pts.n; ++k) c += pts.p[k];
+  return c / pts.n;
+}
+
+}  // namespace
+
+Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+  auto say = [&](const std::string& msg) {
+    if (progress) progress(msg);
+  };
+  Result3d r;
+  Stopwatch clock(r.times);
+  const int max_level = opt.max_level >= 0 ? opt.max_level : opt.level + opt.extra_levels + 2;
+  s.set_global_level(opt.level);
+  s.set_max_level(opt.level + opt.extra_levels);
+  RefineOptions ro;
+  ro.max_level = max_level;
+  ro.max_leaves = opt.max_cells;
+  ro.n_threads = opt.n_threads;
+
+  say("octree: subdividing by the level field (global level " + std::to_string(opt.level) + ")");
+  const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
+  Orthtree<3> tree = subdivide_by_control(s.root_box(), control, ro);
+  r.n_leaves_subdivided = tree.n_leaves();
+  clock.lap("subdivide");
+  say("octree: " + std::to_string(tree.n_leaves()) + " octants; 2:1 balance");
+  // Balanced across faces, edges and corners: every face of an octant then has at most one
+  // level of hanging nodes, which the face templates assume.
+  tree = balance_2to1(tree, BalanceKind::Full);
+  clock.lap("balance");
+
+  const SurfacePointFn surface_point = [&](const P3& p) {
+    const ClosestPoint<3> cp = s.closest_point(p);
+    return std::make_pair(P3(cp.point), cp.where);
+  };
+
+  for (int attempt = 0;; ++attempt) {
+    const bool last = attempt >= opt.max_repairs;
+    say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
+    Flags in = interior_flags(classify(tree, s, opt.n_threads));
+    r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer);
+    r.n_pinches_dropped = remove_pinches(tree, in);
+    clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
+
+    say("boundary octants: projecting the free faces onto the surface");
+    BoundaryOctantOptions bo;
+    bo.snap_features = opt.snap_features;
+    OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
+    clock.lap("boundary octants");
+    std::vector<Problem3> problems = oc.problems;
+
+    TetMesh fe;
+    if (problems.empty()) {
+      say("finite elements: templates");
+      // Feature snaps that invert an element are undone, then the templates are redone.
+      for (int round = 0;; ++round) {
+        fe = tetrahedralize(tree, oc.complex, surface_point);
+        const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
+        std::set<std::int32_t> revert;
+        for (std::size_t e : bad) {
+          const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+          for (int k = 0; k < fe.mesh.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}); ++k) {
+            const std::int32_t id = v[k].v;
+            if (id < static_cast<std::int32_t>(oc.complex.snapped.size()) && oc.complex.snapped[id]) revert.insert(id);
+          }
+        }
+        if (bad.empty() || revert.empty() || round >= 4) {
+          for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
+          break;
+        }
+        for (std::int32_t id : revert) {
+          oc.complex.points[id] = oc.complex.unsnapped[id];
+          oc.complex.where[id] = s.closest_point(oc.complex.unsnapped[id]).where;
+          oc.complex.snapped[id] = 0;
+          ++r.n_snaps_reverted;
+        }
+      }
+      clock.lap("templates");
+    }
+    if (problems.empty()) {
+      say("smoothing: " + std::to_string(opt.smoothing_iterations) + " guarded Laplacian iterations");
+      SmoothOptions<3> so;
+      so.n_iterations = opt.smoothing_iterations;
+      so.fixed.assign(fe.mesh.points.size(), 0);
+      for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
+      const SmoothStats ss = smooth(fe.mesh, so);
+      r.n_smoothing_accepted = ss.moves_accepted;
+      r.n_smoothing_rejected = ss.moves_rejected;
+      clock.lap("smoothing");
+      for (std::size_t e : inverted_elements(fe.mesh))
+        problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});
+    }
+    if (problems.empty()) {
+      r.stats = oc.stats;
+      r.fe = std::move(fe);
+      r.interior = std::move(in);
+      r.tree = std::move(tree);
+      return r;
+    }
+    Flags flags;
+    if (last || !mark_around(tree, problems, max_level, flags))
+      throw GeometryError("the boundary octants cannot be built even at level " + std::to_string(max_level) + ": " +
+                          describe(problems));
+    ++r.n_repairs;
+    r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
+    say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
+        " place(s): " + describe(problems));
+    tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
+    clock.lap("repair refinement");
+  }
+}
+
+}  // namespace febemesh::dim3

@@ -1,0 +1,59 @@
+#pragma once
+// The paper's general algorithm generalised to 3D (its conclusion: boundary octants between
+// the interior octants and the surface): octree by the level field, 2:1 balance, interior
+// octants (buffer and pinch rules), boundary octants by projection, feature snapping, the
+// tetrahedra from templates, guarded smoothing, the BE mesh.
+// Where the construction finds the tree too coarse (no admissible projection, an inverted
+// element), the octants around the place are refined and the construction is redone, up to
+// the maximum level.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/orthtree.hpp"
+#include "dim3/boundary_octants.hpp"
+#include "dim3/surface_boundary.hpp"
+#include "dim3/templates3d.hpp"
+
+namespace febemesh::dim3 {
+
+struct Options3d {
+  int level = 4;                     ///< global level at the surface
+  int extra_levels = 2;              ///< curvature/feature refinement above `level`
+  int smoothing_iterations = 4;      ///< the paper recommends about four
+  double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
+  bool snap_features = true;
+  int max_repairs = 6;               ///< local refinements when the construction needs them
+  int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
+  std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
+  int n_threads = 1;
+};
+
+struct StageTime3 {
+  std::string name;
+  double seconds = 0.0;
+};
+
+struct Result3d {
+  Orthtree<3> tree;                  ///< final tree (after repairs)
+  Flags interior;                    ///< interior octants after buffer and pinch rules
+  TetMesh fe;                        ///< smoothed FE mesh + BE mesh
+  BoundaryOctantStats stats;
+  std::size_t n_leaves_subdivided = 0;
+  std::size_t n_buffer_dropped = 0;
+  std::size_t n_pinches_dropped = 0;
+  std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
+  int n_repairs = 0;
+  std::vector<Problem3> repaired;    ///< what the repairs were for
+  std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
+  std::vector<StageTime3> times;
+};
+
+using Progress3 = std::function<void(const std::string&)>;
+
+/// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
+/// LimitError when the tree would exceed max_cells. `s` gets the options' levels.
+Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
+
+}  // namespace febemesh::dim3

@@ -1,0 +1,222 @@
+#include "dim3/templates3d.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "core/cube_faces.hpp"
+#include "core/error.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+using LP = LatticePoint<3>;
+using Tri = std::array<std::int32_t, 3>;
+
+LP midpoint(const LP& a, const LP& b) { return {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}; }
+
+/// Removes cyclically repeated consecutive ids.
+std::vector<std::int32_t> dedupe_ring(const std::vector<std::int32_t>& r) {
+  std::vector<std::int32_t> out;
+  for (std::int32_t v : r)
+    if (out.empty() || out.back() != v) out.push_back(v);
+  while (out.size() > 1 && out.back() == out.front()) out.pop_back();
+  return out;
+}
+
+/// Smallest angle of triangle abc (radians, 0 when degenerate).
+double min_angle(const P3& a, const P3& b, const P3& c) {
+  const auto ang = [](const P3& o, const P3& u, const P3& v) {
+    const P3 x = u - o, y = v - o;
+    const double n = x.norm() * y.norm();
+    if (n <= 0) return 0.0;
+    return std::atan2(x.cross(y).norm(), x.dot(y));
+  };
+  return std::min({ang(a, b, c), ang(b, c, a), ang(c, a, b)});
+}
+
+struct Builder {
+  const Orthtree<3>& tree;
+  const OctantComplex& oc;
+  const SurfacePointFn& surface_point;
+  TetMesh out;
+  std::map<std::uint64_t, std::int32_t> fan;  // fan centre nodes by lattice point key
+
+  std::int32_t add_point(const P3& p, const BoundaryLocation& w = {}) {
+    out.mesh.add_point(p);
+    out.where.push_back(w);
+    return static_cast<std::int32_t>(out.mesh.points.size() - 1);
+  }
+  std::int32_t lattice_node(const LP& p) const { return oc.lattice.find(p); }
+  std::int32_t fan_node(const LP& p) {
+    const std::uint64_t key = point_key<3>(p);
+    const auto it = fan.find(key);
+    if (it != fan.end()) return it->second;
+    const std::int32_t id = add_point(position(tree, p));
+    fan.emplace(key, id);
+    return id;
+  }
+  void square(const std::array<LP, 4>& q, std::uint32_t len, std::vector<Tri>& tris) {
+    triangulate_square(
+        q, len, [&](const LP& p) { return lattice_node(p); }, [&](const LP& p) { return fan_node(p); }, tris);
+  }
+  /// Cones from a new centroid node at `centre` over the outward triangles.
+  void cones(const std::vector<Tri>& tris, const P3& centre, std::uint8_t level, bool boundary, std::int32_t cell) {
+    const VertexId x{add_point(centre)};
+    for (const Tri& t : tris) {
+      if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+        ++out.n_dropped_degenerate;
+        continue;
+      }
+      out.mesh.solid.add(ElemType::Tet4, {VertexId{t[0]}, VertexId{t[2]}, VertexId{t[1]}, x});
+      out.mesh.level.push_back(level);
+      out.mesh.from_boundary_cell.push_back(boundary ? 1 : 0);
+      out.cell.push_back(cell);
+    }
+  }
+  const P3& at(std::int32_t v) const { return out.mesh.points[v]; }
+};
+
+}  // namespace
+
+void triangulate_quad_by_id(std::array<std::int32_t, 4> q, std::vector<Tri>& out) {
+  const std::vector<std::int32_t> r = dedupe_ring({q[0], q[1], q[2], q[3]});
+  if (r.size() < 3) return;
+  if (r.size() == 3) {
+    out.push_back({r[0], r[1], r[2]});
+    return;
+  }
+  const int m = static_cast<int>(std::min_element(r.begin(), r.end()) - r.begin());
+  if (m % 2 == 0) {
+    out.push_back({r[0], r[1], r[2]});
+    out.push_back({r[0], r[2], r[3]});
+  } else {
+    out.push_back({r[1], r[2], r[3]});
+    out.push_back({r[1], r[3], r[0]});
+  }
+}
+
+void triangulate_square(const std::array<LP, 4>& q, std::uint32_t len,
+                        const std::function<std::int32_t(const LP&)>& lattice_node,
+                        const std::function<std::int32_t(const LP&)>& fan_node, std::vector<Tri>& out) {
+  if (len >= 2) {
+    const LP x = midpoint(q[0], q[2]);
+    if (lattice_node(x) >= 0) {
+      // Finer octants on the other side: the four sub-squares, each counter-clockwise.
+      const LP m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]), m23 = midpoint(q[2], q[3]),
+               m30 = midpoint(q[3], q[0]);
+      const std::uint32_t h = len / 2;
+      triangulate_square({q[0], m01, x, m30}, h, lattice_node, fan_node, out);
+      triangulate_square({m01, q[1], m12, x}, h, lattice_node, fan_node, out);
+      triangulate_square({x, m12, q[2], m23}, h, lattice_node, fan_node, out);
+      triangulate_square({m30, x, m23, q[3]}, h, lattice_node, fan_node, out);
+      return;
+    }
+  }
+  std::vector<std::int32_t> ring;
+  for (int k = 0; k < 4; ++k) {
+    ring.push_back(lattice_node(q[k]));
+    MESH_ASSERT(ring.back() >= 0, "square corner is not a lattice node");
+    if (len >= 2) {
+      const std::int32_t m = lattice_node(midpoint(q[k], q[(k + 1) % 4]));
+      if (m >= 0) ring.push_back(m);
+    }
+  }
+  if (ring.size() == 4) {
+    triangulate_quad_by_id({ring[0], ring[1], ring[2], ring[3]}, out);
+    return;
+  }
+  const std::int32_t c = fan_node(midpoint(q[0], q[2]));
+  for (std::size_t k = 0; k < ring.size(); ++k) out.push_back({c, ring[k], ring[(k + 1) % ring.size()]});
+}
+
+TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const SurfacePointFn& surface_point) {
+  Builder b{t, oc, surface_point, {}, {}};
+  b.out.mesh.points = oc.points;
+  b.out.where = oc.where;
+  std::vector<Tri> tris;
+
+  // Interior octants.
+  for (std::size_t k = 0; k < oc.interior.size(); ++k) {
+    const Cell<3>& c = t.leaf(oc.interior[k]);
+    tris.clear();
+    for (int f = 0; f < Cube<3>::n_faces; ++f) {
+      const auto& fc = FaceCorners<3>::corners[f];
+      b.square({corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])}, length(c), tris);
+    }
+    b.cones(tris, geometry(t, c).center(), c.level, false, static_cast<std::int32_t>(k));
+  }
+
+  // Boundary octants.
+  const std::int32_t n_interior = static_cast<std::int32_t>(oc.interior.size());
+  for (std::size_t k = 0; k < oc.boundary.size(); ++k) {
+    const BoundaryOctant& bo = oc.boundary[k];
+    const std::size_t n = bo.ring.size();
+    std::vector<std::int32_t> p(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      p[i] = oc.projection[bo.ring[i]];
+      MESH_ASSERT(p[i] >= 0, "boundary octant node without projection");
+    }
+    tris.clear();
+    // Face side: the square as seen from the interior octant, reversed.
+    const auto& fc = FaceCorners<3>::corners[bo.face];
+    std::vector<Tri> qtris;
+    b.square({corner(bo.cell, fc[0]), corner(bo.cell, fc[1]), corner(bo.cell, fc[2]), corner(bo.cell, fc[3])},
+             length(bo.cell), qtris);
+    for (const Tri& q : qtris) tris.push_back({q[0], q[2], q[1]});
+    // Sides Qi Qj Pj Pi, one per ring edge (split at hanging midpoints).
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t j = (i + 1) % n;
+      triangulate_quad_by_id({bo.ring[i], bo.ring[j], p[j], p[i]}, tris);
+    }
+    // Surface face: owned by this cell alone.
+    const std::vector<std::int32_t> pr = dedupe_ring(p);
+    std::vector<Tri> ptris;
+    if (pr.size() == 3) {
+      ptris.push_back({pr[0], pr[1], pr[2]});
+    } else if (pr.size() == 4) {
+      const P3 &a = b.at(pr[0]), &c1 = b.at(pr[1]), &c = b.at(pr[2]), &d = b.at(pr[3]);
+      const double q_ac = std::min(min_angle(a, c1, c), min_angle(a, c, d));
+      const double q_bd = std::min(min_angle(a, c1, d), min_angle(c1, c, d));
+      if (q_ac >= q_bd) {
+        ptris.push_back({pr[0], pr[1], pr[2]});
+        ptris.push_back({pr[0], pr[2], pr[3]});
+      } else {
+        ptris.push_back({pr[0], pr[1], pr[3]});
+        ptris.push_back({pr[1], pr[2], pr[3]});
+      }
+    } else if (pr.size() > 4) {
+      P3 mean = P3::Zero();
+      for (std::int32_t v : pr) mean += b.at(v);
+      mean /= static_cast<double>(pr.size());
+      std::int32_t centre;
+      if (surface_point) {
+        const auto [sp, w] = surface_point(mean);
+        centre = b.add_point(sp, w);
+      } else {
+        centre = b.add_point(mean);
+      }
+      for (std::size_t i = 0; i < pr.size(); ++i) ptris.push_back({centre, pr[i], pr[(i + 1) % pr.size()]});
+    }
+    for (const Tri& q : ptris) {
+      if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+      tris.push_back(q);
+      b.out.mesh.interface.add(ElemType::Tri3, {VertexId{q[0]}, VertexId{q[1]}, VertexId{q[2]}});
+    }
+    // Centroid of the distinct corner nodes (face corners and their projections).
+    std::vector<std::int32_t> corners;
+    for (int c = 0; c < 4; ++c) {
+      corners.push_back(bo.ring[bo.corner_slot[c]]);
+      corners.push_back(p[bo.corner_slot[c]]);
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    P3 centre = P3::Zero();
+    for (std::int32_t v : corners) centre += b.at(v);
+    centre /= static_cast<double>(corners.size());
+    b.cones(tris, centre, bo.cell.level, true, n_interior + static_cast<std::int32_t>(k));
+  }
+  return std::move(b.out);
+}
+
+}  // namespace febemesh::dim3

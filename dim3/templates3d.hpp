@@ -1,0 +1,60 @@
+#pragma once
+// Step 6 in 3D: tetrahedra from templates over the interior octants (with hanging nodes) and
+// the boundary octants, and step 5: the BE mesh (the boundary octants' surface faces), sharing
+// nodes.
+//
+// Every cell is split as "cell centroid + each face triangulated" (a cone per face triangle).
+// Conformity rests on one face rule that both cells sharing a face evaluate identically from
+// global data only (lattice nodes and node ids):
+// - a lattice square whose centre is a lattice node (finer octants on the other side) is its
+//   four sub-squares, each by the rule;
+// - a square with lattice nodes at some edge midpoints is fanned from its centre, a node added
+//   once per lattice point and shared by both sides;
+// - a plain quad (square, or a boundary octant's side Qi Qj Pj Pi) is split by the diagonal
+//   through its smallest node id;
+// - coincident projections (the same node twice) shrink a face to a triangle or nothing; cones
+//   with a repeated node are dropped, which leaves prisms, pyramids and tets.
+// The boundary octant's surface face belongs to one cell only: its diagonal is chosen for the
+// better triangles; with hanging midpoints it is fanned from a surface point.
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "core/mesh.hpp"
+#include "core/orthtree.hpp"
+#include "dim3/boundary_octants.hpp"
+
+namespace febemesh::dim3 {
+
+/// Surface point near p with its location (the fan centre of a surface face with hanging nodes).
+using SurfacePointFn = std::function<std::pair<P3, BoundaryLocation>(const P3&)>;
+
+struct TetMesh {
+  Mesh<3> mesh;
+  /// Per mesh node: where it lies on the surface (patch >= 0 for interface nodes).
+  std::vector<BoundaryLocation> where;
+  /// Per solid element: the cell it came from (index into complex.interior, then
+  /// complex.boundary offset by complex.interior.size()).
+  std::vector<std::int32_t> cell;
+  std::size_t n_dropped_degenerate = 0;  ///< cones with a repeated node (degenerate octants)
+};
+
+/// Node ids 0..complex.points.size()-1 of the result are the complex's nodes.
+TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& complex, const SurfacePointFn& surface_point);
+
+/// The triangles (outward, CCW seen from outside the cell) of a lattice square face with
+/// corners `q` counter-clockwise seen from outside, by the face rule above. `lattice_node`
+/// answers a lattice point's node id (-1 if none); `fan_node` gives (or creates) the fan
+/// centre node at a lattice point.
+void triangulate_square(const std::array<LatticePoint<3>, 4>& q, std::uint32_t len,
+                        const std::function<std::int32_t(const LatticePoint<3>&)>& lattice_node,
+                        const std::function<std::int32_t(const LatticePoint<3>&)>& fan_node,
+                        std::vector<std::array<std::int32_t, 3>>& out);
+
+/// A polygon of node ids split by the diagonal through its smallest id (4 nodes), or kept
+/// (3 nodes), after removing cyclically repeated ids; appended to `out`.
+void triangulate_quad_by_id(std::array<std::int32_t, 4> q, std::vector<std::array<std::int32_t, 3>>& out);
+
+}  // namespace febemesh::dim3
