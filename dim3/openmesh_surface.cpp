@@ -26,8 +26,14 @@ std::string lower(std::string s) {
   return s;
 }
 
-/// Number of faces the file declares (-1 if it cannot tell).
-long long declared_faces(const std::string& path, const std::string& ext) {
+struct Declared {
+  long long faces = -1;     ///< -1: the file does not say
+  long long vertices = -1;
+};
+
+/// What the file declares, counted independently of OpenMesh.
+Declared declared_counts(const std::string& path, const std::string& ext) {
+  Declared out;
   std::ifstream in(path, std::ios::binary);
   if (ext == "stl") {
     in.seekg(0, std::ios::end);
@@ -38,20 +44,27 @@ long long declared_faces(const std::string& path, const std::string& ext) {
       in.read(header, 84);
       std::uint32_t n = 0;
       std::memcpy(&n, header + 80, 4);  // little-endian on every platform we build for
-      if (size == 84 + 50LL * n) return n;
+      if (size == 84 + 50LL * n) {
+        out.faces = n;
+        return out;
+      }
     }
     in.clear();
     in.seekg(0);
     long long count = 0;
     for (std::string tok; in >> tok;)
       if (lower(tok) == "endfacet") ++count;
-    return count;
+    out.faces = count;
+    return out;
   }
   if (ext == "obj") {
-    long long count = 0;
-    for (std::string line; std::getline(in, line);)
-      if (line.size() > 1 && line[0] == 'f' && std::isspace(static_cast<unsigned char>(line[1]))) ++count;
-    return count;
+    out.faces = out.vertices = 0;
+    for (std::string line; std::getline(in, line);) {
+      if (line.size() < 2 || !std::isspace(static_cast<unsigned char>(line[1]))) continue;
+      if (line[0] == 'f') ++out.faces;
+      if (line[0] == 'v') ++out.vertices;
+    }
+    return out;
   }
   if (ext == "ply") {
     for (std::string line; std::getline(in, line);) {
@@ -59,11 +72,12 @@ long long declared_faces(const std::string& path, const std::string& ext) {
       std::string a, b;
       long long n = -1;
       ss >> a >> b >> n;
-      if (a == "element" && b == "face") return n;
+      if (a == "element" && b == "face") out.faces = n;
+      if (a == "element" && b == "vertex") out.vertices = n;
       if (a == "end_header") break;
     }
   }
-  return -1;
+  return out;
 }
 
 }  // namespace
@@ -81,13 +95,6 @@ TriangleSoup read_with_openmesh(const std::string& path) {
   if (!ok) throw InputError(path + ": OpenMesh cannot read the file (unreadable or malformed " + ext + ")");
   if (mesh.n_faces() == 0) throw InputError(path + ": empty surface (no faces)");
 
-  const long long declared = declared_faces(path, ext);
-  if (declared >= 0 && declared != static_cast<long long>(mesh.n_faces()))
-    throw InputError(path + ": the file declares " + std::to_string(declared) + " faces but only " +
-                     std::to_string(mesh.n_faces()) +
-                     " could be added: the others are non-manifold (an edge with more than two faces) "
-                     "or degenerate (repeated vertices)");
-
   TriangleSoup soup;
   soup.vertices.reserve(mesh.n_vertices());
   for (const auto vh : mesh.vertices()) {
@@ -98,6 +105,18 @@ TriangleSoup read_with_openmesh(const std::string& path) {
                        std::to_string(q[0]) + ", " + std::to_string(q[1]) + ", " + std::to_string(q[2]) + ")");
     soup.vertices.push_back(p);
   }
+  // OpenMesh either drops a face that would make an edge non-manifold, or duplicates its
+  // vertices to keep the mesh manifold: either way the counts no longer match the file.
+  const Declared declared = declared_counts(path, ext);
+  if (declared.faces >= 0 && declared.faces != static_cast<long long>(mesh.n_faces()))
+    throw InputError(path + ": non-manifold or degenerate faces: the file declares " +
+                     std::to_string(declared.faces) + " faces but only " + std::to_string(mesh.n_faces()) +
+                     " could be added (the others would put more than two faces on an edge, or repeat a vertex)");
+  if (declared.vertices >= 0 && declared.vertices != static_cast<long long>(mesh.n_vertices()))
+    throw InputError(path + ": non-manifold: the file declares " + std::to_string(declared.vertices) +
+                     " vertices but OpenMesh needed " + std::to_string(mesh.n_vertices()) +
+                     " (it duplicates vertices where more than two faces meet at an edge or sheets touch)");
+
   for (const auto fh : mesh.faces()) {
     std::vector<std::int32_t> idx;
     for (const auto vh : mesh.fv_range(fh)) idx.push_back(vh.idx());

@@ -8,6 +8,8 @@
 #include <span>
 #include <vector>
 
+#include <Eigen/Geometry>  // cross products
+
 #include "core/box.hpp"
 
 namespace febemesh::dim3 {

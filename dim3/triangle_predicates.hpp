@@ -7,6 +7,8 @@
 
 #include <cstdint>
 
+#include <Eigen/Geometry>  // cross products
+
 #include "core/box.hpp"
 
 namespace febemesh::dim3 {

@@ -1,0 +1,266 @@
+#include "dim3/surface_boundary.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "core/error.hpp"
+#include "dim3/read_surface.hpp"
+#include "dim3/surface_checks.hpp"
+
+namespace febemesh::dim3 {
+
+namespace {
+
+int edge_slot(TriangleRegion r) { return static_cast<int>(r) - static_cast<int>(TriangleRegion::Edge0); }
+int vertex_slot(TriangleRegion r) { return static_cast<int>(r) - static_cast<int>(TriangleRegion::Vertex0); }
+bool is_edge(TriangleRegion r) { return r >= TriangleRegion::Edge0 && r <= TriangleRegion::Edge2; }
+bool is_vertex(TriangleRegion r) { return r >= TriangleRegion::Vertex0; }
+
+}  // namespace
+
+SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
+    : surface_(std::move(surface)),
+      options_(options),
+      tree_(surface_.vertices(), surface_.triangles()),
+      features_(surface_, options.features) {
+  diagonal_ = surface_.bounding_box().extent().norm();
+  const double root_side = root_box().extent()[0];
+  const int nt = surface_.n_triangles();
+  curvature_level_.assign(nt, -std::numeric_limits<double>::infinity());
+  near_feature_.assign(nt, false);
+  std::vector<P3> centroid(nt);
+  for (std::int32_t t = 0; t < nt; ++t) {
+    const Triangle& tr = surface_.triangle(t);
+    centroid[t] = (surface_.vertex(tr[0]) + surface_.vertex(tr[1]) + surface_.vertex(tr[2])) / 3.0;
+  }
+  for (std::int32_t t = 0; t < nt; ++t) {
+    double kappa = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const std::int32_t e = surface_.triangle_edge(t, i);
+      if (features_.is_feature_edge(e)) {
+        near_feature_[t] = true;
+        continue;
+      }
+      const std::int32_t u = surface_.opposite_triangle(e, t);
+      const double gap = (centroid[u] - centroid[t]).norm();
+      if (gap > 0.0) kappa = std::max(kappa, features_.dihedral(e) / gap);
+    }
+    for (std::int32_t v : surface_.triangle(t))
+      if (features_.is_corner(v)) near_feature_[t] = true;
+    if (kappa > 0.0) curvature_level_[t] = std::log2(root_side * kappa / options_.arc);
+  }
+}
+
+SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptions options) {
+  Surface s(read_surface(path));
+  validate_surface(s, path);
+  return SurfaceBoundary(std::move(s), options);
+}
+
+Box<3> SurfaceBoundary::root_box() const {
+  const Box<3> b = surface_.bounding_box();
+  const double half = 0.5 * 1.05 * b.extent().maxCoeff();
+  Box<3> cube;
+  cube.lo = b.center().array() - half;
+  cube.hi = b.center().array() + half;
+  return cube;
+}
+
+BoundaryLocation SurfaceBoundary::locate(std::int32_t t, const TrianglePoint& tp) const {
+  BoundaryLocation where;
+  where.patch = t;
+  where.param[0] = tp.u;
+  where.param[1] = tp.v;
+  if (is_edge(tp.region)) {
+    const std::int32_t e = surface_.triangle_edge(t, edge_slot(tp.region));
+    if (features_.is_feature_edge(e)) {
+      where.kind = BoundaryLocation::Kind::FeatureEdge;
+      where.feature = features_.feature_edge_index(e);
+    }
+  } else if (is_vertex(tp.region)) {
+    const std::int32_t v = surface_.triangle(t)[vertex_slot(tp.region)];
+    if (features_.is_corner(v)) {
+      where.kind = BoundaryLocation::Kind::Corner;
+      where.feature = features_.corner_index(v);
+    } else if (features_.feature_degree(v) > 0) {
+      // A vertex inside a feature line: on the line, report its first feature edge.
+      for (std::int32_t e : surface_.vertex_edges(v))
+        if (features_.is_feature_edge(e)) {
+          where.kind = BoundaryLocation::Kind::FeatureEdge;
+          where.feature = features_.feature_edge_index(e);
+          break;
+        }
+    }
+  }
+  return where;
+}
+
+ClosestPoint<3> SurfaceBoundary::to_closest(const AabbTree::Closest& c, const P3& p) const {
+  ClosestPoint<3> out;
+  out.point = c.where.point;
+  out.distance = (c.where.point - p).norm();
+  out.where = locate(c.triangle, c.where);
+  return out;
+}
+
+ClosestPoint<3> SurfaceBoundary::closest_point(const P3& p) const { return to_closest(tree_.closest(p), p); }
+
+std::vector<ClosestPoint<3>> SurfaceBoundary::closest_points(const P3& p, int max_count) const {
+  std::vector<ClosestPoint<3>> out;
+  if (max_count <= 0) return out;
+  const AabbTree::Closest first = tree_.closest(p);
+  out.push_back(to_closest(first, p));
+  if (max_count == 1) return out;
+
+  // A candidate is a local minimum of the distance on the surface when it lies inside a face,
+  // or on an edge / at a vertex that no triangle around comes closer to.
+  const double same = 1e-9 * diagonal_;
+  auto distance_to = [&](std::int32_t u) {
+    const auto& q = tree_.points(u);
+    return (closest_on_triangle(p, q[0], q[1], q[2]).point - p).norm();
+  };
+  // Key of the landing element: (0 face | 1 edge | 2 vertex, id).
+  auto key_of = [&](std::int32_t t, TriangleRegion r) {
+    if (is_edge(r)) return std::pair<int, std::int32_t>{1, surface_.triangle_edge(t, edge_slot(r))};
+    if (is_vertex(r)) return std::pair<int, std::int32_t>{2, surface_.triangle(t)[vertex_slot(r)]};
+    return std::pair<int, std::int32_t>{0, t};
+  };
+  const auto first_key = key_of(first.triangle, first.where.region);
+  double radius = std::max(2.0 * out[0].distance, 1e-3 * diagonal_);
+  const double max_radius = out[0].distance + 2.0 * diagonal_;
+  std::vector<std::tuple<double, std::pair<int, std::int32_t>, ClosestPoint<3>>> minima;
+  for (;;) {
+    minima.clear();
+    std::vector<std::pair<int, std::int32_t>> seen{first_key};
+    tree_.for_each_near(p, radius, [&](std::int32_t t) {
+      const auto& q = tree_.points(t);
+      const TrianglePoint tp = closest_on_triangle(p, q[0], q[1], q[2]);
+      const double d = (tp.point - p).norm();
+      if (d > radius) return;
+      const auto key = key_of(t, tp.region);
+      if (std::find(seen.begin(), seen.end(), key) != seen.end()) return;
+      bool local_min = true;
+      if (key.first == 1) {
+        local_min = distance_to(surface_.opposite_triangle(key.second, t)) >= d - same;
+      } else if (key.first == 2) {
+        for (std::int32_t u : surface_.vertex_triangles(key.second))
+          if (distance_to(u) < d - same) local_min = false;
+      }
+      if (!local_min) return;
+      seen.push_back(key);
+      ClosestPoint<3> c;
+      c.point = tp.point;
+      c.distance = d;
+      c.where = locate(t, tp);
+      minima.emplace_back(d, key, c);
+    });
+    const int found = static_cast<int>(minima.size());
+    if (found + 1 >= max_count || radius >= max_radius) break;
+    radius = std::min(2.0 * radius, max_radius);
+  }
+  std::sort(minima.begin(), minima.end(), [](const auto& a, const auto& b) {
+    return std::tie(std::get<0>(a), std::get<1>(a)) < std::tie(std::get<0>(b), std::get<1>(b));
+  });
+  for (const auto& m : minima) {
+    if (static_cast<int>(out.size()) >= max_count) break;
+    const ClosestPoint<3>& c = std::get<2>(m);
+    // Round-off can split one minimum between a face and its edge: keep one.
+    bool duplicate = false;
+    for (const auto& o : out) duplicate = duplicate || (o.point - c.point).norm() <= same;
+    if (!duplicate) out.push_back(c);
+  }
+  return out;
+}
+
+bool SurfaceBoundary::segment_crosses(const P3& a, const P3& b) const {
+  // The open segment: its ends pulled in by 1e-9 of its length, so that a segment ending on the
+  // surface (a node and its projection) does not count as crossing there.
+  const P3 d = b - a;
+  const P3 a1 = a + 1e-9 * d, b1 = b - 1e-9 * d;
+  bool crosses = false;
+  tree_.for_each_on_segment(a1, b1, [&](std::int32_t t) {
+    if (crosses) return;
+    const auto& q = tree_.points(t);
+    crosses = segment_triangle(a1, b1, q[0], q[1], q[2]) != Crossing::Miss;
+  });
+  return crosses;
+}
+
+P3 SurfaceBoundary::pseudo_normal(std::int32_t t, TriangleRegion region) const {
+  if (is_edge(region)) {
+    const std::int32_t e = surface_.triangle_edge(t, edge_slot(region));
+    P3 n = P3::Zero();
+    for (std::int32_t u : surface_.edge_triangles(e)) n += surface_.normal(u);
+    return n;
+  }
+  if (is_vertex(region)) {
+    const std::int32_t v = surface_.triangle(t)[vertex_slot(region)];
+    P3 n = P3::Zero();
+    for (std::int32_t u : surface_.vertex_triangles(v)) {
+      const Triangle& tr = surface_.triangle(u);
+      const int i = tr[0] == v ? 0 : tr[1] == v ? 1 : 2;
+      const P3 a = surface_.vertex(tr[(i + 1) % 3]) - surface_.vertex(v);
+      const P3 b = surface_.vertex(tr[(i + 2) % 3]) - surface_.vertex(v);
+      n += std::atan2(a.cross(b).norm(), a.dot(b)) * surface_.normal(u);
+    }
+    return n;
+  }
+  return surface_.normal(t);
+}
+
+bool SurfaceBoundary::is_inside_ref(const P3& p) const {
+  const AabbTree::Closest c = tree_.closest(p);
+  if (std::sqrt(c.distance2) <= 1e-12 * diagonal_) return false;  // on the surface: not strictly inside
+  return (p - c.where.point).dot(pseudo_normal(c.triangle, c.where.region)) < 0.0;
+}
+
+bool SurfaceBoundary::is_inside(const P3& p) const {
+  if (!surface_.bounding_box().contains(p)) return false;
+  // Ray parity, majority of three rays that miss every edge and vertex by the tolerance.
+  const double reach = 2.0 * diagonal_ + 1.0;
+  int votes_in = 0, votes_out = 0;
+  for (const P3& dir : ray_directions()) {
+    const P3 far = p + reach * dir;
+    int hits = 0;
+    bool degenerate = false;
+    tree_.for_each_on_segment(p, far, [&](std::int32_t t) {
+      if (degenerate) return;
+      const auto& q = tree_.points(t);
+      const Crossing x = segment_triangle(p, far, q[0], q[1], q[2]);
+      if (x == Crossing::Degenerate) degenerate = true;
+      if (x == Crossing::Proper) ++hits;
+    });
+    if (degenerate) continue;
+    (hits % 2 == 1 ? votes_in : votes_out) += 1;
+    if (votes_in >= 2 || votes_out >= 2) break;
+  }
+  if (votes_in == votes_out) return is_inside_ref(p);  // every ray grazed: p is (nearly) on the surface
+  return votes_in > votes_out;
+}
+
+Side SurfaceBoundary::classify(const Box<3>& box) const {
+  // Enlarged a little: touching within round-off counts as meeting (PARTIAL is always safe).
+  Box<3> grown = box;
+  const double pad = 1e-9 * std::max(box.extent().maxCoeff(), diagonal_ * 1e-6);
+  grown.lo.array() -= pad;
+  grown.hi.array() += pad;
+  if (tree_.overlaps(grown)) return Side::Partial;
+  return is_inside(box.center()) ? Side::In : Side::Out;
+}
+
+double SurfaceBoundary::control_level(const Box<3>& box) const {
+  double level = options_.global_level;
+  const double feature_level = options_.global_level + options_.feature_extra_levels;
+  tree_.for_each_in_box(box, [&](std::int32_t t) {
+    if (level >= options_.max_level) return;
+    const double wanted = std::max(curvature_level_[t], near_feature_[t] ? feature_level : level);
+    if (wanted <= level) return;
+    const auto& q = tree_.points(t);
+    if (box_triangle_overlap(box, q[0], q[1], q[2])) level = wanted;
+  });
+  return std::min(level, options_.max_level);
+}
+
+}  // namespace febemesh::dim3

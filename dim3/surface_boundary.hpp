@@ -1,0 +1,86 @@
+#pragma once
+// The 3D boundary (DESIGN.md, "the seam"): a closed, oriented triangle surface with its AABB
+// tree and sharp features, answering what the octree pipeline asks of the boundary.
+//
+// Level field (control_level): the largest of
+//   - the global level (set_global_level),
+//   - global + feature_extra_levels where the box meets a triangle touching a feature edge or
+//     corner,
+//   - the curvature level of every triangle the box meets: log2(root side * kappa / arc), so
+//     that a cell spans at most `arc` radians of the surface's bending; kappa of a triangle is
+//     the largest dihedral angle / centroid distance over its non-feature edges,
+// capped by max_level (set_max_level).
+
+#include <string>
+#include <vector>
+
+#include "core/boundary.hpp"
+#include "dim3/aabb_tree.hpp"
+#include "dim3/features.hpp"
+#include "dim3/surface.hpp"
+
+namespace febemesh::dim3 {
+
+struct SurfaceOptions {
+  FeatureOptions features;
+  double global_level = 3.0;
+  double max_level = 8.0;
+  double feature_extra_levels = 1.0;
+  double arc = 0.5;  ///< radians of bending one cell may span
+};
+
+class SurfaceBoundary final : public Boundary<3> {
+ public:
+  /// Requires a surface that passed validate_surface() (closed, manifold, oriented outward).
+  explicit SurfaceBoundary(Surface surface, SurfaceOptions options = {});
+  /// Reads, validates and orients `path`; throws InputError naming it.
+  static SurfaceBoundary from_file(const std::string& path, SurfaceOptions options = {});
+
+  // ---- Boundary<3> ----
+  Box<3> bounding_box() const override { return surface_.bounding_box(); }
+  Side classify(const Box<3>& box) const override;
+  bool is_inside(const P3& p) const override;
+  ClosestPoint<3> closest_point(const P3& p) const override;
+  std::vector<ClosestPoint<3>> closest_points(const P3& p, int max_count) const override;
+  bool segment_crosses(const P3& a, const P3& b) const override;
+  double control_level(const Box<3>& box) const override;
+
+  // ---- the model ----
+  const Surface& surface() const { return surface_; }
+  const std::vector<P3>& vertices() const { return surface_.vertices(); }
+  const std::vector<Triangle>& triangles() const { return surface_.triangles(); }
+  int n_components() const { return surface_.n_components(); }
+  int euler_characteristic() const { return surface_.euler_characteristic(); }
+  double volume() const { return surface_.volume(); }
+  double area() const { return surface_.area(); }
+  const Features& features() const { return features_; }
+  const AabbTree& tree() const { return tree_; }
+  /// Smallest cube around the bounding box, enlarged by 5%, same centre.
+  Box<3> root_box() const;
+
+  void set_global_level(double level) { options_.global_level = level; }
+  void set_max_level(double level) { options_.max_level = level; }
+  double global_level() const { return options_.global_level; }
+  double max_level() const { return options_.max_level; }
+  /// Curvature level of triangle t (before the global level and the cap).
+  double curvature_level(std::int32_t t) const { return curvature_level_[t]; }
+
+  /// Inside test by the pseudo-normal at the closest point (Baerentzen-Aanaes), the slow twin
+  /// of the ray-parity is_inside().
+  bool is_inside_ref(const P3& p) const;
+
+ private:
+  BoundaryLocation locate(std::int32_t t, const TrianglePoint& tp) const;
+  ClosestPoint<3> to_closest(const AabbTree::Closest& c, const P3& p) const;
+  P3 pseudo_normal(std::int32_t t, TriangleRegion region) const;
+
+  Surface surface_;
+  SurfaceOptions options_;
+  AabbTree tree_;
+  Features features_;
+  std::vector<double> curvature_level_;
+  std::vector<bool> near_feature_;
+  double diagonal_ = 0.0;
+};
+
+}  // namespace febemesh::dim3

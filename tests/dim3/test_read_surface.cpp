@@ -1,0 +1,214 @@
+// Reading surfaces: every closed data file reads with the right counts and topology; bad inputs
+// are refused with the file name and the reason; inverted surfaces are fixed.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "core/error.hpp"
+#include "dim3/read_surface.hpp"
+#include "dim3/surface.hpp"
+#include "dim3/surface_checks.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim3;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string data3d = std::string(FEBEMESH_DATA_DIR) + "/3d/";
+const std::string bad_dir = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/bad_inputs/";
+
+/// Vertex and face counts from an OFF header (skipping comments), independent of read_off.
+std::pair<long, long> off_header_counts(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  bool header = false;
+  while (std::getline(in, line)) {
+    if (const auto h = line.find('#'); h != std::string::npos) line.resize(h);
+    std::istringstream ss(line);
+    std::string first;
+    if (!(ss >> first)) continue;
+    if (!header && first == "OFF") {
+      header = true;
+      continue;
+    }
+    long nv = std::stol(first), nf = 0;
+    ss >> nf;
+    return {nv, nf};
+  }
+  return {-1, -1};
+}
+
+std::string refusal(const std::string& path) {
+  try {
+    Surface s(read_surface(path));
+    validate_surface(s, path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "febemesh_test_read_surface";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// The unit cube, outward, as 8 vertices and 12 triangles.
+const double cube_v[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+const int cube_f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                           {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+
+P3 cube_point(int f, int k) { return P3(cube_v[cube_f[f][k]][0], cube_v[cube_f[f][k]][1], cube_v[cube_f[f][k]][2]); }
+
+}  // namespace
+
+TEST_CASE("every closed data surface reads with its counts and topology", "[read_surface]") {
+  // Euler characteristic 2 - 2g summed over components, as measured (anchor: genus 4 through its
+  // holes, elephant: genus 3, rotor: a torus).
+  const std::map<std::string, int> expected_chi = {{"anchor.off", -6},   {"elephant.off", -4},
+                                                   {"fandisk.off", 2},   {"rotor.off", 0},
+                                                   {"sphere966.off", 2}, {"spool.off", 2}};
+  for (const auto& [file, chi] : expected_chi) {
+    INFO(file);
+    const std::string path = data3d + file;
+    Surface s(read_surface(path));
+    const auto [nv, nf] = off_header_counts(path);
+    CHECK(s.n_vertices() == nv);
+    CHECK(s.n_triangles() == nf);
+    validate_surface(s, path);
+    CHECK(s.n_triangles() == nf);
+    CHECK(s.euler_characteristic() == chi);
+    CHECK(s.volume() > 0.0);
+    CHECK(is_consistently_oriented(s));
+    CHECK(boundary_edges(s).empty());
+    CHECK(s.n_edges() * 2 == s.n_triangles() * 3);
+  }
+}
+
+TEST_CASE("the open cylinder is refused as not closed with its boundary-edge count", "[read_surface]") {
+  const std::string path = data3d + "open-cylinder.off";
+  Surface s(read_surface(path));
+  const auto n_open = boundary_edges(s).size();
+  CHECK(n_open > 0);
+  const std::string msg = refusal(path);
+  INFO(msg);
+  CHECK(msg.find(path) == 0);
+  CHECK(msg.find("surface is not closed: " + std::to_string(n_open) + " boundary edges") != std::string::npos);
+}
+
+TEST_CASE("an inverted sphere is accepted and turned outward", "[read_surface]") {
+  Surface original(read_surface(data3d + "sphere966.off"));
+  validate_surface(original, "sphere966.off");
+  const double v0 = original.volume();
+  const fs::path flipped = scratch("flipped-sphere.off");
+  {
+    std::ofstream out(flipped);
+    out << "OFF\n" << original.n_vertices() << " " << original.n_triangles() << " 0\n";
+    out.precision(17);
+    for (const P3& p : original.vertices()) out << p.x() << " " << p.y() << " " << p.z() << "\n";
+    for (const Triangle& t : original.triangles()) out << "3 " << t[0] << " " << t[2] << " " << t[1] << "\n";
+  }
+  Surface s(read_surface(flipped.string()));
+  CHECK(s.volume() < 0.0);
+  validate_surface(s, flipped.string());
+  CHECK(s.volume() == Approx(v0).epsilon(1e-12));
+  CHECK(is_consistently_oriented(s));
+}
+
+TEST_CASE("a sphere with a cavity: the inner shell is oriented inward", "[read_surface]") {
+  Surface sphere(read_surface(data3d + "sphere966.off"));
+  validate_surface(sphere, "sphere966.off");
+  const P3 c = sphere.bounding_box().center();
+  TriangleSoup soup{sphere.vertices(), sphere.triangles()};
+  const int n = sphere.n_vertices();
+  for (const P3& p : sphere.vertices()) soup.vertices.push_back(c + 0.5 * (p - c));
+  for (const Triangle& t : sphere.triangles()) soup.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});  // same
+  Surface s(std::move(soup));
+  REQUIRE(s.n_components() == 2);
+  validate_surface(s, "shell");
+  CHECK(s.volume() == Approx(sphere.volume() * (1.0 - 0.125)).epsilon(1e-9));
+  CHECK(s.component_volume(0) > 0.0);
+  CHECK(s.component_volume(1) < 0.0);
+}
+
+TEST_CASE("bad inputs are refused with the file name and the reason", "[read_surface]") {
+  const std::map<std::string, std::string> reason = {
+      {"non-manifold.off", "non-manifold: 1 edge"},
+      {"self-intersecting.off", "self-intersecting"},
+      {"nan.off", "non-finite coordinate"},
+      {"index-out-of-range.off", "vertex index 7 out of range"},
+      {"empty.off", "empty file"},
+      {"truncated.off", "truncated"},
+      {"non-manifold.obj", "non-manifold"},
+  };
+  for (const auto& [file, why] : reason) {
+    const std::string path = bad_dir + file;
+    const std::string msg = refusal(path);
+    INFO(file << ": " << msg);
+    CHECK(msg.find(path) == 0);
+    CHECK(msg.find(why) != std::string::npos);
+  }
+  CHECK(refusal(bad_dir + "truncated.off").find("truncated.off:8:") != std::string::npos);
+  CHECK(refusal(bad_dir + "index-out-of-range.off").find(":9:") != std::string::npos);
+}
+
+TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_surface]") {
+  const fs::path obj = scratch("cube.obj"), ply = scratch("cube.ply"), ascii = scratch("cube-ascii.stl"),
+                 binary = scratch("cube-binary.stl");
+  {
+    std::ofstream o(obj), p(ply), a(ascii);
+    p << "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+         "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+    for (const auto& v : cube_v) {
+      o << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
+      p << v[0] << " " << v[1] << " " << v[2] << "\n";
+    }
+    a << "solid cube\n";
+    for (int f = 0; f < 12; ++f) {
+      o << "f " << cube_f[f][0] + 1 << " " << cube_f[f][1] + 1 << " " << cube_f[f][2] + 1 << "\n";
+      p << "3 " << cube_f[f][0] << " " << cube_f[f][1] << " " << cube_f[f][2] << "\n";
+      a << " facet normal 0 0 0\n  outer loop\n";
+      for (int k = 0; k < 3; ++k) {
+        const P3 q = cube_point(f, k);
+        a << "   vertex " << q.x() << " " << q.y() << " " << q.z() << "\n";
+      }
+      a << "  endloop\n endfacet\n";
+    }
+    a << "endsolid cube\n";
+  }
+  {
+    std::ofstream b(binary, std::ios::binary);
+    char header[80] = {};
+    std::memcpy(header, "binary cube", 11);
+    b.write(header, 80);
+    const std::uint32_t n = 12;
+    b.write(reinterpret_cast<const char*>(&n), 4);
+    for (int f = 0; f < 12; ++f) {
+      float values[12] = {};
+      for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) values[3 + 3 * k + d] = static_cast<float>(cube_point(f, k)[d]);
+      b.write(reinterpret_cast<const char*>(values), sizeof values);
+      const std::uint16_t attr = 0;
+      b.write(reinterpret_cast<const char*>(&attr), 2);
+    }
+  }
+  for (const fs::path& path : {obj, ply, ascii, binary}) {
+    INFO(path);
+    Surface s(read_surface(path.string()));
+    CHECK(s.n_triangles() == 12);
+    CHECK(s.n_used_vertices() == 8);
+    validate_surface(s, path.string());
+    CHECK(s.volume() == Approx(1.0));
+    CHECK(s.euler_characteristic() == 2);
+  }
+}
