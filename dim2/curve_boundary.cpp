@@ -357,7 +357,10 @@ void CurveBoundary::junction_minima(int rec, const P2& p, std::vector<Candidate>
   const std::size_t n = loop.n_pieces();
   const Bezier& prev = loop.pieces[(std::size_t(pc.index) + n - 1) % n];
   const P2 v = pc.q[0] - p;
-  if (v.dot(bezier_end_direction(prev)) <= 0.0 && v.dot(bezier_start_direction(pc.q)) >= 0.0)
+  const P2 dir_in = bezier_end_direction(prev), dir_out = bezier_start_direction(pc.q);
+  // A minimum exactly at a smooth junction has both products zero up to rounding.
+  const double tol = 1e-12 * v.norm();
+  if (v.dot(dir_in) <= tol * dir_in.norm() && v.dot(dir_out) >= -tol * dir_out.norm())
     out.push_back({v.squaredNorm(), rec, 0.0});
 }
 
@@ -395,27 +398,26 @@ std::vector<ClosestPoint<2>> CurveBoundary::closest_points(const P2& p, int max_
 }
 
 ClosestPoint<2> CurveBoundary::closest_point_ref(const P2& p, int samples) const {
+  // Every piece: its best sample, polished by golden section within one sample step.
   double best = inf, best_u = 0.0;
   int best_rec = 0;
-  for (int r = 0; r < int(pieces_.size()); ++r)
-    for (int k = 0; k <= samples; ++k) {
-      const double u = double(k) / samples;
-      const double d = (bezier_point(pieces_[std::size_t(r)].q, u) - p).squaredNorm();
-      if (d < best) { best = d; best_u = u; best_rec = r; }
-    }
-  // Golden-section polish around the best sample.
-  const Bezier& q = pieces_[std::size_t(best_rec)].q;
-  double lo = std::max(0.0, best_u - 1.0 / samples), hi = std::min(1.0, best_u + 1.0 / samples);
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-  for (int it = 0; it < 200 && hi - lo > 1e-15; ++it) {
-    const double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
-    if ((bezier_point(q, a) - p).squaredNorm() < (bezier_point(q, b) - p).squaredNorm()) hi = b;
-    else lo = a;
+  for (int r = 0; r < int(pieces_.size()); ++r) {
+    const Bezier& q = pieces_[std::size_t(r)].q;
+    auto f = [&](double u) { return (bezier_point(q, u) - p).squaredNorm(); };
+    double piece_best = inf, su = 0.0;
+    for (int k = 0; k <= samples; ++k)
+      if (f(double(k) / samples) < piece_best) { piece_best = f(double(k) / samples); su = double(k) / samples; }
+    double lo = std::max(0.0, su - 1.0 / samples), hi = std::min(1.0, su + 1.0 / samples);
+    for (int it = 0; it < 200 && hi - lo > 1e-15; ++it) {
+      const double a = hi - g * (hi - lo), b = lo + g * (hi - lo);
+      if (f(a) < f(b)) hi = b;
+      else lo = a;
+    }
+    for (double u : {0.5 * (lo + hi), su})
+      if (f(u) < best) { best = f(u); best_u = u; best_rec = r; }
   }
-  double u = 0.5 * (lo + hi);
-  for (double e : {0.0, 1.0})
-    if ((bezier_point(q, e) - p).squaredNorm() <= (bezier_point(q, u) - p).squaredNorm()) u = e;
-  return make_result(best_rec, u, p);
+  return make_result(best_rec, best_u, p);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -176,17 +176,32 @@ void check_domain(const Domain& domain) {
         if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
           throw InputError(src + ": loop '" + l.name + "' has a non-finite point " + coords(p));
   const double tol = check_tolerance(domain);
+  auto zero_area = [&](const Loop& l) {
+    const Box<2> box = bounding_box(l);
+    return InputError(src + ": loop '" + l.name + "' encloses zero area (it lies within " + coords(box.lo) + " - " +
+                      coords(box.hi) + ")");
+  };
   for (const Loop& l : domain.loops) {
     if (l.pieces.empty()) throw InputError(src + ": loop '" + l.name + "' is degenerate (it has no extent)");
-    const Box<2> box = bounding_box(l);
-    const double size = box.extent().norm();
-    if (!(size > tol) || std::abs(signed_area(l)) <= 1e-12 * size * size)
-      throw InputError(src + ": loop '" + l.name + "' encloses zero area (it lies within " + coords(box.lo) +
-                       " - " + coords(box.hi) + ")");
+    // A flat loop (all control points on one line) is reported as such, not as overlapping itself.
+    const P2 o = l.pieces[0][0];
+    P2 far = o;
+    for (const Bezier& q : l.pieces)
+      for (const P2& p : q)
+        if ((p - o).norm() > (far - o).norm()) far = p;
+    const double size = (far - o).norm();
+    double off_line = 0.0;
+    for (const Bezier& q : l.pieces)
+      for (const P2& p : q) off_line = std::max(off_line, std::abs(cross(far - o, p - o)));
+    if (!(size > tol) || off_line <= 1e-12 * size * size) throw zero_area(l);
   }
   for (const Loop& l : domain.loops)
     if (auto p = loop_self_intersection(l, tol))
       throw InputError(src + ": loop '" + l.name + "' intersects itself at " + coords(*p));
+  for (const Loop& l : domain.loops) {
+    const double size = bounding_box(l).extent().norm();
+    if (std::abs(signed_area(l)) <= 1e-12 * size * size) throw zero_area(l);
+  }
   for (std::size_t i = 0; i < domain.loops.size(); ++i)
     for (std::size_t j = i + 1; j < domain.loops.size(); ++j) {
       const Box<2> bi = bounding_box(domain.loops[i]), bj = bounding_box(domain.loops[j]);
