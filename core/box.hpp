@@ -2,6 +2,8 @@
 // Real-valued points and axis-aligned boxes: where lattice cells meet geometry.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products
+#include <Eigen/LU>        // determinants
 #include <Eigen/Geometry>  // cross(): declared by Core, defined here
 #include <limits>
 

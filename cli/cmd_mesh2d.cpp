@@ -1,0 +1,155 @@
+// febemesh mesh2d: the paper's general algorithm on a 2D input (native JSON, SVG, .poly).
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include "cli/args.hpp"
+#include "cli/command.hpp"
+#include "core/atomic_output.hpp"
+#include "core/error.hpp"
+#include "core/process_stats.hpp"
+#include "core/validate.hpp"
+#include "core/write_msh.hpp"
+#include "core/write_vtu.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/fidelity2d.hpp"
+#include "dim2/figures2d.hpp"
+#include "dim2/pipeline2d.hpp"
+#include "dim2/read_domain.hpp"
+#include "dim2/report2d.hpp"
+
+namespace febemesh::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace febemesh::dim2;
+
+const char* const help = R"(usage: febemesh mesh2d INPUT -o DIR [options]
+
+Meshes the solid bounded by the closed curves of INPUT (native .json B-spline loops, .svg paths,
+Triangle .poly) with the paper's modified quadtree: interior quadrants, boundary quadrants by
+projection onto the curve, corner pulling, Laplacian smoothing, a BE mesh on the curve and an FE
+mesh from templates that share its nodes.
+
+options:
+  -o, --output DIR      output folder (written atomically; replaced if it exists)
+  --level N             mesh control level at the curve (quadrant size = root / 2^N); default:
+                        the file's levels, else automatic from curvature and thickness
+  --elements KIND       tri (default) | quad | mixed
+  --smooth N            Laplacian smoothing iterations (default 4, as the paper)
+  --slide               let boundary nodes slide along the curve while smoothing
+  --buffer F            drop interior quadrants nearer the curve than F x their size (default 0.35)
+  --max-level N         finest level allowed, repairs included (default 16)
+  --max-cells N         refuse trees larger than N quadrants (default 20000000)
+  --threads N           threads for subdivision and classification (default: all cores)
+  --no-figures          do not write figures/*.svg
+  --no-validate         skip the final validation (benchmarks)
+  --quiet               no progress on stderr
+
+outputs in DIR: mesh.msh (Gmsh MSH 4.1; physical groups "solid" and "interface"), mesh.vtu,
+report.json, figures/*.svg (one per stage of the paper).
+exit status: 0 success, 1 bad input, 2 bad usage.
+)";
+
+/// Refuses a level whose mesh would exhaust memory, before building anything.
+void check_budget(const CurveBoundary& curve, double level, std::size_t max_cells) {
+  if (level < 0) return;
+  double perimeter = 0.0;
+  for (int l = 0; l < curve.n_loops(); ++l) perimeter += curve.length(l);
+  const Box<2> root = curve.root_box();
+  const double h = (root.hi[0] - root.lo[0]) / std::ldexp(1.0, static_cast<int>(std::ceil(level)));
+  const double estimate = 6.0 * perimeter / h + 16.0;  // boundary band plus the graded interior
+  if (estimate > static_cast<double>(max_cells)) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "level " << level << " would need about " << estimate << " quadrants (~" << estimate * 400 / 1e9
+       << " GB) which exceeds the limit of " << max_cells << " (--max-cells)";
+    throw LimitError(os.str());
+  }
+}
+
+int run(const std::vector<std::string>& argv) {
+  const Args args(argv, {"--slide", "--no-figures", "--no-validate", "--quiet"},
+                  {"-o", "--output", "--level", "--elements", "--smooth", "--buffer", "--max-level", "--max-cells",
+                   "--threads"});
+  args.expect_positional({"INPUT"});
+  const std::string input = args.positional()[0];
+  const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
+  if (out.empty()) throw UsageError("missing -o DIR");
+
+  Options2d opt;
+  opt.level = args.real_or("--level", no_level, 0, 28);
+  opt.elements = element_kind_from(args.choice_or("--elements", "tri", {"tri", "quad", "mixed"}));
+  opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 1000);
+  opt.slide_boundary = args.has("--slide");
+  opt.buffer = args.real_or("--buffer", 0.35, 0.0, 0.95);
+  opt.max_level = args.int_or("--max-level", 16, 1, 28);
+  opt.max_cells = static_cast<std::size_t>(args.real_or("--max-cells", 2e7, 1e2, 1e10));
+  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  opt.n_threads = args.int_or("--threads", hw, 1, 256);
+  opt.keep_stages = !args.has("--no-figures");
+  const bool quiet = args.has("--quiet");
+
+  const auto start = std::chrono::steady_clock::now();
+  auto progress = [&](const std::string& s) {
+    if (!quiet) std::cerr << "mesh2d: " << s << "\n";
+  };
+  progress("reading " + input);
+  Domain domain = read_domain(input);
+  CurveBoundary curve(std::move(domain));
+  if (opt.level != no_level) curve.set_global_level(opt.level);
+  curve.set_max_level(opt.max_level);
+  check_budget(curve, opt.level != no_level ? opt.level : curve.global_level(), opt.max_cells);
+
+  Result2d r = mesh2d(curve, opt, progress);
+  const Fidelity2d fid = measure_fidelity(r.fe, curve);
+
+  ValidationReport valid;
+  if (!args.has("--no-validate")) {
+    progress("validating " + std::to_string(r.fe.mesh.solid.size()) + " elements");
+    ValidateOptions<2> vo;
+    vo.expected_euler = curve.n_components() - curve.n_holes();
+    const Box<2> bb = curve.bounding_box();
+    vo.boundary_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
+    vo.boundary_tolerance = 1e-10 * (bb.hi - bb.lo).norm();
+    valid = validate<2>(r.fe.mesh, vo);
+    if (!valid.valid)
+      throw std::runtime_error("the mesh of " + input + " failed validation (please report):\n" + valid.summary());
+  }
+
+  progress("writing " + out);
+  AtomicOutputDir dir(out);
+  write_msh<2>(r.fe.mesh, dir.file("mesh.msh"));
+  write_vtu<2>(r.fe.mesh, dir.file("mesh.vtu"));
+  if (opt.keep_stages) {
+    write_stage_figures(r, curve, dir.file("figures"));
+    draw_geometry_figure(curve, dir.file("figures") / "00-geometry.svg");
+  }
+  RunInfo info;
+  info.input = input;
+  info.version = FEBEMESH_VERSION;
+  info.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  info.peak_memory_bytes = peak_memory_bytes();
+  {
+    std::ofstream rep(dir.file("report.json"));
+    rep << report_json(r, curve, opt, fid, valid, info);
+    if (!rep) throw InputError(dir.file("report.json").string() + ": cannot write");
+  }
+  dir.commit();
+  if (!quiet) {
+    std::cerr << "mesh2d: " << r.fe.mesh.solid.size() << " FE elements, " << r.fe.mesh.interface.size()
+              << " BE elements, " << r.fe.mesh.points.size() << " nodes in " << info.total_seconds << " s\n";
+  }
+  std::cout << fs::path(out).string() << "\n";
+  return exit_ok;
+}
+
+}  // namespace
+
+FEBEMESH_COMMAND(Command{"mesh2d", "mesh a 2D solid (FE) and its interface (BE) by the modified quadtree", help, run});
+
+}  // namespace febemesh::cli

@@ -1,0 +1,93 @@
+#include "core/free_facets.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace febemesh {
+
+template <int Dim>
+std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> FreeFacet<Dim>::corners() const {
+  std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> out;
+  for (int k = 0; k < Cube<Dim>::n_face_corners; ++k) out[k] = corner(cell, FaceCorners<Dim>::corners[face][k]);
+  return out;
+}
+
+template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep) {
+  std::vector<FreeFacet<Dim>> out;
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
+    if (!keep[i]) continue;
+    const Cell<Dim>& c = t.leaf(i);
+    for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+      const std::vector<std::size_t> nb = face_neighbours(t, i, f);
+      if (nb.empty()) {
+        out.push_back({i, f, c});
+        continue;
+      }
+      const bool finer = t.leaf(nb[0]).level > c.level;
+      if (!finer) {
+        if (!keep[nb[0]]) out.push_back({i, f, c});
+        continue;
+      }
+      // Finer side: if none of them is kept, the whole facet is free (its sub-facet corners
+      // would not be nodes); otherwise each unkept finer neighbour gives a free sub-facet.
+      const bool any_kept = std::any_of(nb.begin(), nb.end(), [&](std::size_t n) { return keep[n] != 0; });
+      if (!any_kept) {
+        out.push_back({i, f, c});
+        continue;
+      }
+      for (std::size_t n : nb) {
+        if (keep[n]) continue;
+        Cell<Dim> mirror;
+        // The finer neighbour's mirror inside `c` across facet f (opposite facet of the neighbour).
+        const bool ok = face_neighbour(t.leaf(n), f ^ 1, mirror);
+        MESH_ASSERT(ok, "finer neighbour has no mirror inside its coarser neighbour");
+        (void)ok;
+        out.push_back({i, f, mirror});
+      }
+    }
+  }
+  return out;
+}
+
+template <int Dim>
+bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
+                         double rel_tol) {
+  Box<Dim> sb = Box<Dim>::empty();
+  sb.expand(a);
+  sb.expand(b);
+  for (std::size_t i : leaves_in_box(t, sb)) {
+    if (!keep[i]) continue;
+    Box<Dim> box = geometry(t, t.leaf(i));
+    const double shrink = rel_tol * (box.hi[0] - box.lo[0]);
+    box.lo.array() += shrink;
+    box.hi.array() -= shrink;
+    // Slab clipping of the segment against the shrunk open box.
+    double t0 = 0.0, t1 = 1.0;
+    bool hit = true;
+    for (int d = 0; d < Dim && hit; ++d) {
+      const double dir = b[d] - a[d];
+      if (std::abs(dir) < 1e-300) {
+        if (a[d] <= box.lo[d] || a[d] >= box.hi[d]) hit = false;
+        continue;
+      }
+      double s0 = (box.lo[d] - a[d]) / dir, s1 = (box.hi[d] - a[d]) / dir;
+      if (s0 > s1) std::swap(s0, s1);
+      t0 = std::max(t0, s0);
+      t1 = std::min(t1, s1);
+      if (t0 >= t1) hit = false;
+    }
+    if (hit) return true;
+  }
+  return false;
+}
+
+template struct FreeFacet<2>;
+template struct FreeFacet<3>;
+template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const Flags&);
+template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const Flags&);
+template bool segment_enters_kept<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&, double);
+template bool segment_enters_kept<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&, double);
+
+}  // namespace febemesh

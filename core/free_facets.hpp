@@ -1,0 +1,34 @@
+#pragma once
+// Free facets of the kept (IN) cells: the facets not shared with another kept cell. The paper
+// builds one boundary cell on each of them. A facet half-shared with finer kept cells is split
+// into the sub-facets of the finer side, so every free facet is a facet of some (possibly
+// virtual) cell whose corners are all lattice nodes.
+
+#include <array>
+#include <vector>
+
+#include "core/cube_faces.hpp"
+#include "core/orthtree.hpp"
+
+namespace febemesh {
+
+template <int Dim> struct FreeFacet {
+  std::size_t leaf = no_leaf;  ///< the kept leaf behind the facet
+  int face = -1;               ///< which facet of `cell`
+  Cell<Dim> cell;              ///< the leaf, or its descendant of the finer side for a sub-facet
+
+  /// The facet's corners as lattice points, in FaceCorners<Dim> order (outward orientation).
+  std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> corners() const;
+};
+
+/// All free facets of the kept leaves (keep[i] != 0), in leaf order then facet order.
+/// Requires a 2:1 face-balanced tree.
+template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep);
+
+/// Does the segment [a, b] pass through the interior of a kept leaf? (The paper: the projection
+/// segments must not cross other quadrants.) Cells are shrunk by `rel_tol` of their size.
+template <int Dim>
+bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
+                         double rel_tol = 1e-9);
+
+}  // namespace febemesh

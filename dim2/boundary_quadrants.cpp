@@ -1,0 +1,376 @@
+#include "dim2/boundary_quadrants.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "core/cube_faces.hpp"
+#include "core/error.hpp"
+#include "core/free_facets.hpp"
+
+namespace febemesh::dim2 {
+namespace {
+
+using LP = LatticePoint<2>;
+
+LP midpoint(const LP& a, const LP& b) { return {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2}; }
+
+/// The kept leaves having lattice point p as a corner.
+std::vector<std::size_t> kept_leaves_at(const Orthtree<2>& t, const Flags& in, const LP& p) {
+  std::vector<std::size_t> out;
+  for (int dy = -1; dy <= 0; ++dy)
+    for (int dx = -1; dx <= 0; ++dx) {
+      if ((p[0] == 0 && dx < 0) || (p[1] == 0 && dy < 0)) continue;
+      const LP q{p[0] + static_cast<std::uint32_t>(dx), p[1] + static_cast<std::uint32_t>(dy)};
+      const std::size_t i = locate(t, q);
+      if (i == no_leaf || !in[i]) continue;
+      bool is_corner = false;
+      for (int k = 0; k < 4; ++k) is_corner = is_corner || corner(t.leaf(i), k) == p;
+      if (is_corner && std::find(out.begin(), out.end(), i) == out.end()) out.push_back(i);
+    }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double facet_length(const Orthtree<2>& t, const FreeFacet<2>& f) { return length(f.cell) * t.unit(); }
+
+/// Signed parameter step from a to b on a periodic loop of period n, in (-n/2, n/2].
+double wrapped_step(double a, double b, double n) {
+  double d = std::fmod(b - a, n);
+  if (d > 0.5 * n) d -= n;
+  if (d <= -0.5 * n) d += n;
+  return d;
+}
+
+double wrap(double t, double n) {
+  double r = std::fmod(t, n);
+  if (r < 0) r += n;
+  if (r >= n) r -= n;
+  return r;
+}
+
+struct Projector {
+  const Orthtree<2>& tree;
+  const Flags& in;
+  const CurveBoundary& curve;
+  const BoundaryQuadrantOptions& opt;
+  BoundaryQuadrantStats& stats;
+
+  /// The segment from q to a curve point p is admissible: it enters no interior quadrant and
+  /// does not cross the curve before reaching p.
+  bool admissible(const Point<2>& q, const Point<2>& p) const {
+    if (segment_enters_kept(tree, in, q, p)) return false;
+    const Point<2> short_end = q + (1.0 - 1e-7) * (p - q);
+    return !curve.segment_crosses(q, short_end);
+  }
+
+  /// Closest point of the curve to q whose segment is admissible (paper: the shortest normal,
+  /// then the next normals, then walking along the curve from the closest point).
+  bool project(const Point<2>& q, double h, ClosestPoint<2>& out) {
+    const std::vector<ClosestPoint<2>> cands = curve.closest_points(q, opt.max_normals);
+    for (std::size_t k = 0; k < cands.size(); ++k) {
+      if (admissible(q, cands[k].point)) {
+        out = cands[k];
+        if (k > 0) ++stats.n_next_normal;
+        return true;
+      }
+    }
+    if (cands.empty()) return false;
+    const ClosestPoint<2>& start = cands.front();
+    const int loop = start.where.patch;
+    const double n = static_cast<double>(curve.loops()[loop].n_pieces());
+    for (int side : {+1, -1}) {
+      double tpar = start.where.param[0];
+      for (int step = 0; step < 256; ++step) {
+        const double speed = std::max(curve.derivative(loop, wrap(tpar, n)).norm(), 1e-300);
+        tpar += side * (0.125 * h) / speed;
+        const double tw = wrap(tpar, n);
+        const Point<2> p = curve.evaluate(loop, tw);
+        if ((p - q).norm() > 4.0 * (start.distance + h)) break;
+        if (admissible(q, p)) {
+          out.point = p;
+          out.distance = (p - q).norm();
+          out.where.patch = loop;
+          out.where.param[0] = tw;
+          out.where.kind = BoundaryLocation::Kind::Smooth;
+          out.where.feature = -1;
+          ++stats.n_walked;
+          return true;
+        }
+      }
+    }
+    return false;
+  }
+};
+
+struct Chain {
+  std::vector<std::int32_t> q;       ///< lattice node ids, in order (IN region on the left)
+  std::vector<std::size_t> facet;    ///< facet starting at q[k]
+};
+
+}  // namespace
+
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in) {
+  std::size_t removed = 0;
+  for (int pass = 0; pass < 64; ++pass) {
+    std::map<LP, int> outgoing;  // ordered: deterministic
+    for (const FreeFacet<2>& f : free_facets(t, in)) ++outgoing[f.corners()[0]];
+    std::vector<std::size_t> drop;
+    for (const auto& [p, count] : outgoing) {
+      if (count < 2) continue;
+      const std::vector<std::size_t> cells = kept_leaves_at(t, in, p);
+      if (!cells.empty()) drop.push_back(cells.front());
+    }
+    if (drop.empty()) break;
+    for (std::size_t i : drop) {
+      if (in[i]) {
+        in[i] = 0;
+        ++removed;
+      }
+    }
+  }
+  return removed;
+}
+
+std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction) {
+  if (fraction <= 0) return 0;
+  std::size_t removed = 0;
+  for (int pass = 0; pass < 4; ++pass) {
+    std::vector<std::size_t> drop;
+    for (const FreeFacet<2>& f : free_facets(t, in)) {
+      const auto c = f.corners();
+      const double h = facet_length(t, f);
+      const Point<2> a = position(t, c[0]), b = position(t, c[1]);
+      const double d = std::min({curve.closest_point(a).distance, curve.closest_point(b).distance,
+                                 curve.closest_point(0.5 * (a + b)).distance});
+      if (d < fraction * h) drop.push_back(f.leaf);
+    }
+    std::sort(drop.begin(), drop.end());
+    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
+    if (drop.empty()) break;
+    for (std::size_t i : drop) in[i] = 0;
+    removed += drop.size();
+  }
+  return removed;
+}
+
+QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& in, const CurveBoundary& curve,
+                                             const BoundaryQuadrantOptions& opt) {
+  QuadrantComplexResult res;
+  QuadrantComplex& qc = res.complex;
+  const LatticeNodes<2> nodes = lattice_nodes(t, &in);
+  for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
+
+  // Interior quadrants: CCW rings with hanging mid-edge nodes.
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
+    if (!in[i]) continue;
+    const Cell<2>& c = t.leaf(i);
+    InteriorQuadrant q;
+    q.leaf = i;
+    q.level = c.level;
+    for (int k = 0; k < 4; ++k) {
+      const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
+      q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
+      q.ring.push_back(nodes.find(a));
+      if (length(c) >= 2) {
+        const std::int32_t m = nodes.find(midpoint(a, b));
+        if (m >= 0) q.ring.push_back(m);
+      }
+    }
+    qc.interior.push_back(std::move(q));
+  }
+
+  // Free edges and their chains.
+  const std::vector<FreeFacet<2>> facets = free_facets(t, in);
+  res.stats.n_free_edges = facets.size();
+  std::vector<std::int32_t> next_facet(nodes.points.size(), -1);
+  std::vector<std::array<std::int32_t, 2>> ends(facets.size());
+  for (std::size_t k = 0; k < facets.size(); ++k) {
+    const auto c = facets[k].corners();
+    ends[k] = {nodes.find(c[0]), nodes.find(c[1])};
+    MESH_ASSERT(ends[k][0] >= 0 && ends[k][1] >= 0, "free edge corner is not a node");
+    if (next_facet[ends[k][0]] >= 0) {
+      res.problems.push_back({qc.points[ends[k][0]], "interior quadrants meet only at a vertex"});
+      continue;
+    }
+    next_facet[ends[k][0]] = static_cast<std::int32_t>(k);
+    qc.kind[ends[k][0]] = NodeKind::Chain;
+    qc.kind[ends[k][1]] = NodeKind::Chain;
+  }
+  if (!res.problems.empty()) return res;
+
+  std::vector<Chain> chains;
+  std::vector<std::uint8_t> used(facets.size(), 0);
+  for (std::size_t k0 = 0; k0 < facets.size(); ++k0) {
+    if (used[k0]) continue;
+    Chain ch;
+    std::int32_t k = static_cast<std::int32_t>(k0);
+    while (k >= 0 && !used[k]) {
+      used[k] = 1;
+      ch.q.push_back(ends[k][0]);
+      ch.facet.push_back(static_cast<std::size_t>(k));
+      k = next_facet[ends[k][1]];
+    }
+    if (k < 0) {
+      res.problems.push_back({qc.points[ch.q.front()], "free edges do not close into a chain"});
+      return res;
+    }
+    chains.push_back(std::move(ch));
+  }
+  res.stats.n_chains = chains.size();
+
+  // Project every chain node (paper eq. 1 with the crossing rule).
+  Projector proj{t, in, curve, opt, res.stats};
+  std::vector<int> chains_on_loop(curve.loops().size(), 0);
+  for (const Chain& ch : chains) {
+    const std::size_t m = ch.q.size();
+    std::vector<ClosestPoint<2>> cp(m);
+    std::vector<double> h(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      h[k] = facet_length(t, facets[ch.facet[k]]);
+      if (!proj.project(qc.points[ch.q[k]], h[k], cp[k])) {
+        res.problems.push_back({qc.points[ch.q[k]], "no admissible projection onto the curve"});
+      }
+    }
+    if (!res.problems.empty()) continue;
+
+    // The chain follows one loop: the loop most of its nodes project onto.
+    std::map<int, int> votes;
+    for (const auto& c : cp) ++votes[c.where.patch];
+    const int loop = std::max_element(votes.begin(), votes.end(), [](auto& a, auto& b) {
+                       return a.second < b.second;
+                     })->first;
+    bool mixed = false;
+    for (std::size_t k = 0; k < m; ++k) {
+      if (cp[k].where.patch != loop) {
+        res.problems.push_back({qc.points[ch.q[k]], "a chain of free edges projects onto two loops"});
+        mixed = true;
+      }
+    }
+    if (mixed) continue;
+    ++chains_on_loop[loop];
+    const double n = static_cast<double>(curve.loops()[loop].n_pieces());
+
+    // Unwrap the parameters; the chain must go once around its loop, forwards.
+    std::vector<double> u(m);
+    u[0] = cp[0].where.param[0];
+    double total = 0.0;
+    for (std::size_t k = 1; k <= m; ++k) {
+      const double d = wrapped_step(cp[k - 1].where.param[0], cp[k % m].where.param[0], n);
+      total += d;
+      if (k < m) u[k] = u[k - 1] + d;
+    }
+    if (std::abs(total - n) > 1e-6 * n) {
+      std::ostringstream os;
+      os << "the free edges go " << total / n << " times around loop '" << curve.loops()[loop].name
+         << "' (a feature thinner than the quadrants)";
+      res.problems.push_back({qc.points[ch.q[0]], os.str()});
+      continue;
+    }
+    // Keep the order along the curve: forward running maximum, then backward minimum against
+    // the closing node, so that every boundary quadrant has P1 before P2 (or P1 == P2).
+    std::vector<double> v = u;
+    for (std::size_t k = 1; k < m; ++k) v[k] = std::max(v[k], v[k - 1]);
+    for (std::size_t k = m - 1; k >= 1; --k) v[k] = std::min(v[k], k + 1 < m ? v[k + 1] : u[0] + n);
+
+    // Pull the nearest boundary node onto each corner of this loop.
+    std::vector<std::int32_t> corner_at(m, -1);
+    if (opt.pull_corners) {
+      const auto& corners = curve.corners();
+      for (std::size_t ci = 0; ci < corners.size(); ++ci) {
+        if (corners[ci].loop != loop) continue;
+        // Corner parameter unwrapped into [v0, v0 + n).
+        double tc = corners[ci].t;
+        while (tc < v[0]) tc += n;
+        while (tc >= v[0] + n) tc -= n;
+        std::size_t best = 0;
+        double best_d = std::numeric_limits<double>::infinity();
+        for (std::size_t k = 0; k < m; ++k) {
+          for (double shift : {-n, 0.0, n}) {
+            const double d = std::abs(v[k] + shift - tc);
+            if (d < best_d) best_d = d, best = k;
+          }
+        }
+        const double dist = (curve.evaluate(loop, wrap(v[best], n)) - corners[ci].point).norm();
+        if (corner_at[best] >= 0 || dist > opt.corner_pull_radius * h[best] ||
+            !proj.admissible(qc.points[ch.q[best]], corners[ci].point)) {
+          if (opt.corners_may_fail) {
+            ++res.stats.n_corners_missed;
+          } else {
+            res.problems.push_back({corners[ci].point, "no boundary node close enough to pull onto the corner"});
+          }
+          continue;
+        }
+        // Bring the corner parameter next to v[best] and clamp neighbours that pass it.
+        double target = tc;
+        for (double shift : {-n, n})
+          if (std::abs(tc + shift - v[best]) < std::abs(target - v[best])) target = tc + shift;
+        v[best] = target;
+        for (std::size_t k = best; k-- > 0;) v[k] = std::min(v[k], target);
+        for (std::size_t k = best + 1; k < m; ++k) v[k] = std::max(v[k], target);
+        corner_at[best] = static_cast<std::int32_t>(ci);
+        ++res.stats.n_corners_pulled;
+      }
+      if (v[m - 1] > v[0] + n) {
+        res.problems.push_back({qc.points[ch.q[0]], "corner pulling reversed the boundary nodes"});
+        continue;
+      }
+    }
+
+    // Boundary nodes: one per distinct parameter along the chain (equal ones are shared).
+    std::vector<std::int32_t> pnode(m, -1);
+    for (std::size_t k = 0; k < m; ++k) {
+      if (v[k] != u[k] && corner_at[k] < 0) ++res.stats.n_clamped;
+      if (k > 0 && v[k] == v[k - 1]) {
+        pnode[k] = pnode[k - 1];
+        continue;
+      }
+      if (k > 0 && v[k] == v[0] + n) {  // closes onto the chain's first boundary node
+        pnode[k] = pnode[0];
+        continue;
+      }
+      BoundaryLocation w;
+      w.patch = loop;
+      w.param[0] = wrap(v[k], n);
+      Point<2> p;
+      if (corner_at[k] >= 0) {
+        const auto& c = curve.corners()[corner_at[k]];
+        p = c.point;
+        w.param[0] = c.t;
+        w.kind = BoundaryLocation::Kind::Corner;
+        w.feature = corner_at[k];
+      } else if (v[k] == u[k]) {
+        p = cp[k].point;
+        w = cp[k].where;
+      } else {
+        p = curve.evaluate(loop, w.param[0]);
+      }
+      if (v[k] != u[k] && corner_at[k] < 0 && !proj.admissible(qc.points[ch.q[k]], p)) {
+        res.problems.push_back({qc.points[ch.q[k]], "a projection kept in order crosses an interior quadrant"});
+      }
+      pnode[k] = qc.add_node(p, NodeKind::Boundary, w);
+    }
+
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::size_t kn = (k + 1) % m;
+      const FreeFacet<2>& f = facets[ch.facet[k]];
+      BoundaryQuadrant b;
+      b.node = {ch.q[kn], ch.q[k], pnode[k], pnode[kn]};
+      b.leaf = f.leaf;
+      b.level = f.cell.level;
+      if (b.is_triangle()) ++res.stats.n_triangles;
+      qc.boundary.push_back(b);
+    }
+  }
+  for (std::size_t l = 0; l < chains_on_loop.size() && res.problems.empty(); ++l) {
+    if (chains_on_loop[l] == 1) continue;
+    std::ostringstream os;
+    os << "loop '" << curve.loops()[l].name << "' is reached by " << chains_on_loop[l]
+       << " chains of interior quadrants instead of one";
+    res.problems.push_back({curve.evaluate(static_cast<int>(l), 0.0), os.str()});
+  }
+  return res;
+}
+
+}  // namespace febemesh::dim2

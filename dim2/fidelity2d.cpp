@@ -1,0 +1,55 @@
+#include "dim2/fidelity2d.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/quality.hpp"
+#include "dim2/loop_geometry.hpp"
+
+namespace febemesh::dim2 {
+namespace {
+
+double point_segment_distance(const P2& p, const P2& a, const P2& b) {
+  const P2 ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (p - (a + s * ab)).norm();
+}
+
+}  // namespace
+
+Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int samples) {
+  Fidelity2d f;
+  f.exact_area = curve.area();
+  f.fe_area = solid_measure<2>(m.mesh);
+  f.be_polygon_area = interface_enclosed_measure<2>(m.mesh);
+  f.area_rel_error = std::abs(f.fe_area - f.exact_area) / f.exact_area;
+  const Box<2> bb = curve.bounding_box();
+  const double diag = (bb.hi - bb.lo).norm();
+  for (std::size_t e = 0; e < m.mesh.interface.size(); ++e) {
+    const VertexId* v = m.mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const BoundaryLocation &wa = m.where[v[0].v], &wb = m.where[v[1].v];
+    const P2 &a = m.mesh.points[v[0].v], &b = m.mesh.points[v[1].v];
+    if (wa.patch < 0 || wa.patch != wb.patch) {
+      f.hausdorff = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    const Loop& loop = curve.loops()[wa.patch];
+    const double n = static_cast<double>(loop.n_pieces());
+    double d = std::fmod(wb.param[0] - wa.param[0], n);
+    if (d < 0) d += n;
+    for (int s = 1; s < samples; ++s) {
+      const P2 p = evaluate(loop, wrap_parameter(loop, wa.param[0] + d * s / samples));
+      f.hausdorff = std::max(f.hausdorff, point_segment_distance(p, a, b));
+    }
+  }
+  for (std::size_t v = 0; v < m.where.size(); ++v) {
+    if (m.where[v].patch < 0) continue;
+    f.max_node_distance = std::max(f.max_node_distance, curve.closest_point(m.mesh.points[v]).distance);
+  }
+  f.hausdorff_rel = f.hausdorff / diag;
+  f.max_node_distance_rel = f.max_node_distance / diag;
+  return f;
+}
+
+}  // namespace febemesh::dim2

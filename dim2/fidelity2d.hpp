@@ -1,0 +1,26 @@
+#pragma once
+// Geometric fidelity of a 2D mesh against the exact curve (DESIGN.md "Validity and quality"):
+// area error, a Hausdorff estimate between the BE mesh and the curve, and how far the interface
+// nodes are from the curve.
+
+#include "dim2/curve_boundary.hpp"
+#include "dim2/templates2d.hpp"
+
+namespace febemesh::dim2 {
+
+struct Fidelity2d {
+  double exact_area = 0.0;        ///< of the B-spline domain (Green's theorem, exact)
+  double fe_area = 0.0;           ///< sum of the FE element areas
+  double be_polygon_area = 0.0;   ///< area enclosed by the BE polygons
+  double area_rel_error = 0.0;    ///< |fe_area - exact_area| / exact_area
+  double hausdorff = 0.0;         ///< max over BE edges of the curve's distance to the edge
+  double hausdorff_rel = 0.0;     ///< hausdorff / diagonal of the curve's bounding box
+  double max_node_distance = 0.0; ///< max distance of an interface node to the curve
+  double max_node_distance_rel = 0.0;
+};
+
+/// `samples` curve points per BE edge for the Hausdorff estimate (one-sided from the curve,
+/// which dominates: the BE edges are chords of the curve).
+Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int samples = 16);
+
+}  // namespace febemesh::dim2

@@ -1,0 +1,181 @@
+#include "dim2/pipeline2d.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "core/quality.hpp"
+#include "core/smooth.hpp"
+#include "dim2/loop_geometry.hpp"
+
+namespace febemesh::dim2 {
+namespace {
+
+class Stopwatch {
+ public:
+  explicit Stopwatch(std::vector<StageTime>& out) : out_(out) {}
+  void lap(const std::string& name) {
+    const auto now = std::chrono::steady_clock::now();
+    out_.push_back({name, std::chrono::duration<double>(now - last_).count()});
+    last_ = now;
+  }
+
+ private:
+  std::vector<StageTime>& out_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+Flags interior_flags(const std::vector<Side>& sides) {
+  Flags in(sides.size());
+  for (std::size_t i = 0; i < sides.size(); ++i) in[i] = sides[i] == Side::In ? 1 : 0;
+  return in;
+}
+
+/// Mark the leaves around each problem for one more subdivision. Returns false when none can
+/// be refined any more (all at max_level).
+bool mark_around(const Orthtree<2>& t, const std::vector<Problem>& problems, int max_level, Flags& flags) {
+  flags.assign(t.n_leaves(), 0);
+  bool any = false;
+  for (const Problem& pr : problems) {
+    const std::size_t i = locate(t, pr.where);
+    const double h = i == no_leaf ? t.unit() * length(t.leaf(0)) : t.unit() * length(t.leaf(i));
+    Box<2> b;
+    b.lo = pr.where.array() - 2.0 * h;
+    b.hi = pr.where.array() + 2.0 * h;
+    for (std::size_t j : leaves_in_box(t, b)) {
+      if (t.leaf(j).level < max_level) {
+        flags[j] = 1;
+        any = true;
+      }
+    }
+  }
+  return any;
+}
+
+std::string describe(const std::vector<Problem>& problems) {
+  std::ostringstream os;
+  os.precision(6);
+  const std::size_t shown = std::min<std::size_t>(problems.size(), 3);
+  for (std::size_t k = 0; k < shown; ++k)
+    os << (k ? "; " : "") << problems[k].what << " near (" << problems[k].where[0] << ", " << problems[k].where[1]
+       << ")";
+  if (problems.size() > shown) os << "; and " << problems.size() - shown << " more";
+  return os.str();
+}
+
+/// Elements that came out inverted (or flat), as problems at their centroids.
+std::vector<Problem> inverted_elements(const Mesh<2>& m) {
+  std::vector<Problem> out;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const auto pts = element_points<2>(m.solid, id, m.points);
+    if (min_corner_jacobian<2>(m.solid.type[e], pts.span()) > 0) continue;
+    Point<2> c = Point<2>::Zero();
+    for (int k = 0; k < pts.n; ++k) c += pts.p[k];
+    out.push_back({c / pts.n, "an element is inverted"});
+  }
+  return out;
+}
+
+}  // namespace
+
+Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress& progress) {
+  auto say = [&](const std::string& s) {
+    if (progress) progress(s);
+  };
+  Result2d r;
+  Stopwatch clock(r.times);
+  RefineOptions ro;
+  ro.max_level = opt.max_level;
+  ro.max_leaves = opt.max_cells;
+  ro.n_threads = opt.n_threads;
+
+  say("quadrant generation: subdividing by the mesh control parameters");
+  const ControlFn<2> control = [&](const Box<2>& b) { return curve.control_level(b); };
+  Orthtree<2> tree = subdivide_by_control(curve.root_box(), control, ro);
+  clock.lap("subdivide");
+  if (opt.keep_stages) r.subdivided = tree;
+  say("quadrant generation: " + std::to_string(tree.n_leaves()) + " quadrants; one-level-difference rule");
+  tree = balance_2to1(tree, BalanceKind::Face);
+  clock.lap("balance");
+  if (opt.keep_stages) r.balanced = tree;
+
+  const CurveMidpoint midpoint = [&](const BoundaryLocation& a, const BoundaryLocation& b) {
+    const Loop& loop = curve.loops()[a.patch];
+    const double n = static_cast<double>(loop.n_pieces());
+    double d = std::fmod(b.param[0] - a.param[0], n);
+    if (d < 0) d += n;
+    BoundaryLocation w;
+    w.patch = a.patch;
+    w.param[0] = wrap_parameter(loop, a.param[0] + 0.5 * d);
+    return std::make_pair(evaluate(loop, w.param[0]), w);
+  };
+
+  for (int attempt = 0;; ++attempt) {
+    const bool last = attempt >= opt.max_repairs;
+    say("interior quadrants: classifying " + std::to_string(tree.n_leaves()) + " quadrants");
+    Flags in = interior_flags(classify(tree, curve, opt.n_threads));
+    r.n_buffer_dropped = apply_buffer(tree, in, curve, opt.buffer);
+    r.n_pinches_dropped = remove_pinches(tree, in);
+    clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
+
+    say("boundary quadrants: projecting the free edges onto the curve");
+    BoundaryQuadrantOptions bo;
+    bo.corners_may_fail = last;
+    QuadrantComplexResult bq = build_quadrant_complex(tree, in, curve, bo);
+    clock.lap("boundary quadrants");
+    std::vector<Problem> problems = bq.problems;
+
+    FeBeMesh fe;
+    if (problems.empty()) {
+      say("finite elements: templates");
+      fe = fe_be_mesh(bq.complex, opt.elements, midpoint);
+      clock.lap("templates");
+      say("smoothing: " + std::to_string(opt.smoothing_iterations) + " Laplacian iterations");
+      SmoothOptions<2> so;
+      so.n_iterations = opt.smoothing_iterations;
+      if (opt.slide_boundary) {
+        so.fixed.assign(fe.mesh.points.size(), 0);
+        for (std::size_t v = 0; v < fe.where.size(); ++v)
+          if (fe.where[v].kind == BoundaryLocation::Kind::Corner) so.fixed[v] = 1;
+        so.project = [&](const Point<2>& p) { return Point<2>(curve.closest_point(p).point); };
+      }
+      const SmoothStats ss = smooth(fe.mesh, so);
+      r.n_smoothing_rejected = ss.moves_rejected;
+      if (opt.slide_boundary) {
+        for (std::size_t v = 0; v < fe.where.size(); ++v)
+          if (fe.where[v].patch >= 0 && fe.where[v].kind != BoundaryLocation::Kind::Corner)
+            fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
+      }
+      clock.lap("smoothing");
+      problems = inverted_elements(fe.mesh);
+    }
+    if (problems.empty()) {
+      r.stats = bq.stats;
+      r.fe = std::move(fe);
+      if (opt.keep_stages) {
+        r.complex = std::move(bq.complex);
+        BoundaryQuadrantOptions no_pull = bo;
+        no_pull.pull_corners = false;
+        r.before_pulling = build_quadrant_complex(tree, in, curve, no_pull).complex;
+      }
+      r.interior = std::move(in);
+      r.tree = std::move(tree);
+      return r;
+    }
+    Flags flags;
+    if (last || !mark_around(tree, problems, opt.max_level, flags))
+      throw GeometryError("the boundary quadrants cannot be built even at level " + std::to_string(opt.max_level) +
+                          ": " + describe(problems));
+    ++r.n_repairs;
+    r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
+    say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
+        " place(s): " + describe(problems));
+    tree = balance_2to1(refine(tree, flags), BalanceKind::Face);
+    clock.lap("repair refinement");
+  }
+}
+
+}  // namespace febemesh::dim2

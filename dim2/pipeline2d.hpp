@@ -1,0 +1,63 @@
+#pragma once
+// The paper's general algorithm (steps 1-7) in 2D: quadrant generation (subdivision by the
+// mesh control parameters, 2:1 balance, interior quadrants), boundary quadrants by
+// projection, corner pulling, smoothing, the BE mesh and the FE mesh from templates.
+// Where the construction finds the tree too coarse (a feature thinner than the quadrants, a
+// projection with no admissible segment, an inverted element), the quadrants around the place
+// are refined and the construction is redone, up to the maximum level.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/orthtree.hpp"
+#include "dim2/boundary_quadrants.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/templates2d.hpp"
+
+namespace febemesh::dim2 {
+
+struct Options2d {
+  double level = no_level;           ///< global level at the curve; no_level = the file's or automatic
+  ElementKind elements = ElementKind::Tri;
+  int smoothing_iterations = 4;      ///< the paper recommends about four
+  bool slide_boundary = false;       ///< let boundary nodes slide along the curve while smoothing
+  double buffer = 0.35;              ///< drop interior quadrants nearer the curve than this x size
+  int max_level = 16;                ///< no quadrant finer than this (repairs included)
+  int max_repairs = 8;               ///< local refinements when the construction needs them
+  std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
+  int n_threads = 1;
+  bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures
+};
+
+struct StageTime {
+  std::string name;
+  double seconds = 0.0;
+};
+
+struct Result2d {
+  // Stages, kept when Options2d::keep_stages (the paper's Figures 3-12).
+  Orthtree<2> subdivided;           ///< after check_and_subdivide_quadrant
+  Orthtree<2> balanced;             ///< after the one-level-difference rule
+  Orthtree<2> tree;                 ///< final tree (after repairs)
+  Flags interior;                   ///< interior quadrants of `tree` after buffer and pinch rules
+  QuadrantComplex before_pulling;   ///< boundary quadrants before corner pulling
+  QuadrantComplex complex;          ///< after corner pulling
+  // Result.
+  FeBeMesh fe;                      ///< smoothed FE mesh + BE mesh
+  BoundaryQuadrantStats stats;
+  std::size_t n_buffer_dropped = 0;
+  std::size_t n_pinches_dropped = 0;
+  int n_repairs = 0;
+  std::vector<Problem> repaired;    ///< what the repairs were for
+  std::size_t n_smoothing_rejected = 0;
+  std::vector<StageTime> times;
+};
+
+using Progress = std::function<void(const std::string&)>;
+
+/// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
+/// LimitError when the tree would exceed max_cells.
+Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress& progress = {});
+
+}  // namespace febemesh::dim2

@@ -1,0 +1,54 @@
+#pragma once
+// The quadrants after the paper's step 3 (interior quadrants plus boundary quadrants), with
+// shared nodes: what smoothing, the BE mesh and the FE templates work on.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/boundary.hpp"
+#include "core/box.hpp"
+
+namespace febemesh::dim2 {
+
+enum class NodeKind : std::uint8_t {
+  Interior = 0,  ///< a lattice node of the interior quadrants, off the free edges
+  Chain = 1,     ///< a lattice node on a free edge (the paper's Q points)
+  Boundary = 2   ///< a projection on the curve (the paper's P points)
+};
+
+struct InteriorQuadrant {
+  std::size_t leaf = 0;
+  std::uint8_t level = 0;
+  /// Nodes counter-clockwise from the lower-left corner, hanging mid-edge nodes included.
+  std::vector<std::int32_t> ring;
+  /// corner_slot[k]: position in `ring` of corner k of FaceCorners<2>::ring order (ll, lr, ur, ul).
+  std::array<std::uint8_t, 4> corner_slot{};
+  bool has_hanging() const { return ring.size() > 4; }
+};
+
+/// A boundary quadrant, counter-clockwise: Q2, Q1 (the free edge, reversed), P1, P2 (on the
+/// curve). P1 == P2 makes it a triangle (the paper's coincident projections).
+struct BoundaryQuadrant {
+  std::array<std::int32_t, 4> node{};  ///< Q2, Q1, P1, P2
+  std::size_t leaf = 0;                ///< the interior quadrant behind the free edge
+  std::uint8_t level = 0;              ///< level of the free edge's cell
+  bool is_triangle() const { return node[2] == node[3]; }
+};
+
+struct QuadrantComplex {
+  std::vector<Point<2>> points;
+  std::vector<NodeKind> kind;
+  std::vector<BoundaryLocation> where;  ///< meaningful for Boundary nodes
+  std::vector<InteriorQuadrant> interior;
+  std::vector<BoundaryQuadrant> boundary;
+
+  std::int32_t add_node(const Point<2>& p, NodeKind k, const BoundaryLocation& w = {}) {
+    points.push_back(p);
+    kind.push_back(k);
+    where.push_back(w);
+    return static_cast<std::int32_t>(points.size() - 1);
+  }
+};
+
+}  // namespace febemesh::dim2

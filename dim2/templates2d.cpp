@@ -1,0 +1,179 @@
+#include "dim2/templates2d.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "core/error.hpp"
+
+namespace febemesh::dim2 {
+namespace {
+
+using P2 = Point<2>;
+
+double cross(const P2& a, const P2& b, const P2& c) {
+  return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/// Smallest angle of triangle abc in radians (0 if degenerate).
+double min_angle(const P2& a, const P2& b, const P2& c) {
+  const double la = (b - c).norm(), lb = (c - a).norm(), lc = (a - b).norm();
+  if (la <= 0 || lb <= 0 || lc <= 0) return 0.0;
+  auto ang = [](double opp, double s1, double s2) {
+    return std::acos(std::clamp((s1 * s1 + s2 * s2 - opp * opp) / (2 * s1 * s2), -1.0, 1.0));
+  };
+  return std::min({ang(la, lb, lc), ang(lb, lc, la), ang(lc, la, lb)});
+}
+
+VertexId vid(std::int32_t i) { return VertexId{i}; }
+
+struct Builder {
+  FeBeMesh out;
+  void tri(std::int32_t a, std::int32_t b, std::int32_t c, std::uint8_t level, bool bnd) {
+    out.mesh.solid.add(ElemType::Tri3, {vid(a), vid(b), vid(c)});
+    out.mesh.level.push_back(level);
+    out.mesh.from_boundary_cell.push_back(bnd ? 1 : 0);
+  }
+  void quad(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, std::uint8_t level, bool bnd) {
+    out.mesh.solid.add(ElemType::Quad4, {vid(a), vid(b), vid(c), vid(d)});
+    out.mesh.level.push_back(level);
+    out.mesh.from_boundary_cell.push_back(bnd ? 1 : 0);
+  }
+  std::int32_t point(const P2& p, const BoundaryLocation& w = {}) {
+    out.mesh.add_point(p);
+    out.where.push_back(w);
+    return static_cast<std::int32_t>(out.mesh.points.size() - 1);
+  }
+  const P2& at(std::int32_t i) const { return out.mesh.points[i]; }
+};
+
+/// Two triangles of quad abcd (CCW) across the diagonal with the better smallest angle;
+/// ties go to the a-c diagonal so the result is deterministic.
+void split_quad(Builder& b, std::int32_t a, std::int32_t c1, std::int32_t c, std::int32_t d, std::uint8_t level,
+                bool bnd) {
+  const P2 &pa = b.at(a), &pb = b.at(c1), &pc = b.at(c), &pd = b.at(d);
+  double q_ac = std::min(min_angle(pa, pb, pc), min_angle(pa, pc, pd));
+  if (cross(pa, pb, pc) <= 0 || cross(pa, pc, pd) <= 0) q_ac = -1;
+  double q_bd = std::min(min_angle(pa, pb, pd), min_angle(pb, pc, pd));
+  if (cross(pa, pb, pd) <= 0 || cross(pb, pc, pd) <= 0) q_bd = -1;
+  if (q_ac >= q_bd) {
+    b.tri(a, c1, c, level, bnd);
+    b.tri(a, c, d, level, bnd);
+  } else {
+    b.tri(a, c1, d, level, bnd);
+    b.tri(c1, c, d, level, bnd);
+  }
+}
+
+void interior_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
+  for (const InteriorQuadrant& q : qc.interior) {
+    const auto& r = q.ring;
+    const std::int32_t ll = r[q.corner_slot[0]], lr = r[q.corner_slot[1]], ur = r[q.corner_slot[2]],
+                       ul = r[q.corner_slot[3]];
+    if (!q.has_hanging()) {
+      if (kind == ElementKind::Tri)
+        split_quad(b, ll, lr, ur, ul, q.level, false);
+      else
+        b.quad(ll, lr, ur, ul, q.level, false);
+      continue;
+    }
+    const P2 centre = 0.25 * (b.at(ll) + b.at(lr) + b.at(ur) + b.at(ul));
+    const std::int32_t c = b.point(centre);
+    for (std::size_t k = 0; k < r.size(); ++k) b.tri(c, r[k], r[(k + 1) % r.size()], q.level, false);
+  }
+}
+
+void boundary_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
+  for (const BoundaryQuadrant& q : qc.boundary) {
+    const auto& n = q.node;
+    if (q.is_triangle()) {
+      b.tri(n[0], n[1], n[2], q.level, true);
+    } else if (kind == ElementKind::Tri) {
+      split_quad(b, n[0], n[1], n[2], n[3], q.level, true);
+    } else {
+      b.quad(n[0], n[1], n[2], n[3], q.level, true);
+    }
+    if (n[2] != n[3]) b.out.mesh.interface.add(ElemType::Line2, {vid(n[2]), vid(n[3])});
+  }
+}
+
+/// Split every element once: triangle -> 3 quads, quad -> 4 quads (conforming through shared
+/// edge midpoints; curve edges get their midpoint on the curve).
+FeBeMesh split_to_quads(const FeBeMesh& in, const CurveMidpoint& midpoint) {
+  Builder b;
+  b.out.mesh.points = in.mesh.points;
+  b.out.where = in.where;
+  std::map<std::pair<std::int32_t, std::int32_t>, std::int32_t> mid;
+  std::map<std::pair<std::int32_t, std::int32_t>, bool> on_curve;
+  for (std::size_t e = 0; e < in.mesh.interface.size(); ++e) {
+    const VertexId* v = in.mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    on_curve[{std::min(v[0].v, v[1].v), std::max(v[0].v, v[1].v)}] = true;
+  }
+  auto edge_mid = [&](std::int32_t a, std::int32_t c) {
+    const std::pair<std::int32_t, std::int32_t> key{std::min(a, c), std::max(a, c)};
+    auto it = mid.find(key);
+    if (it != mid.end()) return it->second;
+    std::int32_t m;
+    if (on_curve.count(key)) {
+      auto [p, w] = midpoint(b.out.where[a], b.out.where[c]);
+      m = b.point(p, w);
+    } else {
+      m = b.point(0.5 * (b.at(a) + b.at(c)));
+    }
+    mid.emplace(key, m);
+    return m;
+  };
+  for (std::size_t e = 0; e < in.mesh.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const VertexId* v = in.mesh.solid.nodes(id);
+    const int n = in.mesh.solid.n_nodes_of(id);
+    P2 centre = P2::Zero();
+    for (int k = 0; k < n; ++k) centre += b.at(v[k].v);
+    const std::int32_t c = b.point(centre / n);
+    for (int k = 0; k < n; ++k) {
+      const std::int32_t prev = v[(k + n - 1) % n].v, cur = v[k].v, next = v[(k + 1) % n].v;
+      b.quad(cur, edge_mid(cur, next), c, edge_mid(prev, cur), in.mesh.level[e], in.mesh.from_boundary_cell[e]);
+    }
+  }
+  for (std::size_t e = 0; e < in.mesh.interface.size(); ++e) {
+    const VertexId* v = in.mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const std::int32_t m = edge_mid(v[0].v, v[1].v);
+    b.out.mesh.interface.add(ElemType::Line2, {v[0], vid(m)});
+    b.out.mesh.interface.add(ElemType::Line2, {vid(m), v[1]});
+  }
+  return std::move(b.out);
+}
+
+}  // namespace
+
+const char* name(ElementKind k) {
+  switch (k) {
+    case ElementKind::Tri: return "tri";
+    case ElementKind::Quad: return "quad";
+    case ElementKind::Mixed: return "mixed";
+  }
+  return "?";
+}
+
+ElementKind element_kind_from(const std::string& s) {
+  if (s == "tri") return ElementKind::Tri;
+  if (s == "quad") return ElementKind::Quad;
+  if (s == "mixed") return ElementKind::Mixed;
+  throw std::invalid_argument("element kind must be tri, quad or mixed, got '" + s + "'");
+}
+
+FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint) {
+  Builder b;
+  b.out.mesh.points = qc.points;
+  b.out.where.resize(qc.points.size());
+  for (std::size_t i = 0; i < qc.points.size(); ++i)
+    if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where[i];
+  const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
+  interior_templates(b, qc, base);
+  boundary_templates(b, qc, base);
+  if (kind == ElementKind::Quad) return split_to_quads(b.out, midpoint);
+  return std::move(b.out);
+}
+
+}  // namespace febemesh::dim2
