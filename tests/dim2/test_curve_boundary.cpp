@@ -7,6 +7,7 @@
 #include "dim2/bezier.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/loop_geometry.hpp"
+#include "dim2/read_domain.hpp"
 #include "property.hpp"
 
 using namespace febemesh;
@@ -222,4 +223,26 @@ TEST_CASE("control levels: explicit, interpolated, interior, global and automati
   CHECK(tb.root_box().extent().x() / std::pow(2.0, thin) <= 0.05 * 1.0001);
   tb.set_max_level(4);
   CHECK(tb.control_level(Box<2>{P2(4.9, -0.01), P2(5.1, 0.01)}) == 4.0);
+}
+
+TEST_CASE("every shared 2D data file passes the checks and orients consistently", "[boundary][data]") {
+  for (const char* name : {"DejaVuSans-U0038", "DejaVuSans-U0041", "DejaVuSans-U0042", "DejaVuSans-U004F",
+                           "DejaVuSans-U0065", "DejaVuSerif-Bold-U0052", "NimbusSans-Regular-U0061",
+                           "NimbusSans-Regular-U0067"}) {
+    INFO(name);
+    const CurveBoundary b(read_domain(std::string(FEBEMESH_DATA_DIR) + "/2d/" + name + ".svg"));
+    CHECK(b.area() > 0.0);
+    double sum = 0.0;
+    for (int i = 0; i < b.n_loops(); ++i) {
+      CHECK((b.signed_area(i) > 0) == !b.is_hole(i));
+      sum += b.signed_area(i);
+    }
+    CHECK(b.area() == Approx(sum));
+    // The closest point of a few points agrees with brute force.
+    const Box<2> box = b.bounding_box();
+    for (int k = 0; k < 20; ++k) {
+      const P2 p = box.lo + P2((k % 5) / 4.0 * box.extent().x(), (k / 5) / 3.0 * box.extent().y());
+      CHECK(b.closest_point(p).distance <= b.closest_point_ref(p, 100).distance + 1e-12 * box.extent().maxCoeff());
+    }
+  }
 }
