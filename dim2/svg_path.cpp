@@ -170,7 +170,7 @@ Affine parse_transform(std::string_view text) {
     total = total * t;
     sc.skip_comma_wsp();
   }
-  if (std::abs(total.a.determinant()) == 0.0)
+  if (total.a(0, 0) * total.a(1, 1) - total.a(0, 1) * total.a(1, 0) == 0.0)
     throw PathDataError(0, "transform is singular (it collapses the drawing)");
   return total;
 }
