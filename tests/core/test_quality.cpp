@@ -1,0 +1,123 @@
+// core/quality.hpp: Verdict measures on shapes whose values are known.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "core/quality.hpp"
+#include "test_mesh_fixtures.hpp"
+
+using namespace febemesh;
+
+namespace {
+template <int Dim> ElementQuality q_of(ElemType t, std::vector<Point<Dim>> p) { return element_quality<Dim>(t, {p.data(), p.size()}); }
+}  // namespace
+
+TEST_CASE("triangles: equilateral and right isosceles", "[quality]") {
+  using P = Point<2>;
+  const auto eq = q_of<2>(ElemType::Tri3, {P(0, 0), P(1, 0), P(0.5, std::sqrt(3.0) / 2)});
+  CHECK(eq.min_angle_deg == Approx(60.0));
+  CHECK(eq.max_angle_deg == Approx(60.0));
+  CHECK(eq.scaled_jacobian == Approx(1.0));
+  CHECK(eq.aspect_ratio == Approx(1.0));
+
+  const auto right = q_of<2>(ElemType::Tri3, {P(0, 0), P(1, 0), P(0, 1)});
+  CHECK(right.min_angle_deg == Approx(45.0));
+  CHECK(right.max_angle_deg == Approx(90.0));
+  CHECK(right.scaled_jacobian == Approx(std::sin(M_PI / 4) * 2 / std::sqrt(3.0)));
+  // Verdict aspect ratio: l_max (l0 + l1 + l2) / (4 sqrt(3) A).
+  CHECK(right.aspect_ratio == Approx(std::sqrt(2.0) * (2 + std::sqrt(2.0)) / (4 * std::sqrt(3.0) * 0.5)));
+
+  const auto inverted = q_of<2>(ElemType::Tri3, {P(0, 0), P(0.5, std::sqrt(3.0) / 2), P(1, 0)});
+  CHECK(inverted.scaled_jacobian == Approx(-1.0));
+  // The same triangle in 3D (an interface element) is measured unsigned.
+  using Q = Point<3>;
+  CHECK(q_of<3>(ElemType::Tri3, {Q(0, 0, 0), Q(0, 1, 0), Q(1, 0, 0)}).min_angle_deg == Approx(45.0));
+}
+
+TEST_CASE("quads: square, rectangle, non-convex", "[quality]") {
+  using P = Point<2>;
+  const auto sq = q_of<2>(ElemType::Quad4, {P(0, 0), P(1, 0), P(1, 1), P(0, 1)});
+  CHECK(sq.scaled_jacobian == Approx(1.0));
+  CHECK(sq.min_angle_deg == Approx(90.0));
+  CHECK(sq.max_angle_deg == Approx(90.0));
+  CHECK(sq.aspect_ratio == Approx(1.0));
+  const auto rect = q_of<2>(ElemType::Quad4, {P(0, 0), P(2, 0), P(2, 1), P(0, 1)});
+  CHECK(rect.scaled_jacobian == Approx(1.0));
+  CHECK(rect.aspect_ratio == Approx(2.0 * 6.0 / (4.0 * 2.0)));
+  std::vector<P> dart = {P(0, 0), P(2, 0), P(0.5, 0.5), P(0, 2)};
+  CHECK(scaled_jacobian<2>(ElemType::Quad4, {dart.data(), 4}) < 0.0);
+  CHECK(min_corner_jacobian<2>(ElemType::Quad4, {dart.data(), 4}) < 0.0);
+  CHECK(signed_measure<2>(ElemType::Quad4, {dart.data(), 4}) == Approx(1.0));
+}
+
+TEST_CASE("tets: regular, right corner, sliver", "[quality]") {
+  using P = Point<3>;
+  const auto reg = q_of<3>(ElemType::Tet4, {P(1, 1, 1), P(-1, 1, -1), P(1, -1, -1), P(-1, -1, 1)});
+  CHECK(reg.min_angle_deg == Approx(std::acos(1.0 / 3.0) * 180 / M_PI));  // 70.5288
+  CHECK(reg.max_angle_deg == Approx(70.528779));
+  CHECK(reg.scaled_jacobian == Approx(1.0));
+  CHECK(reg.radius_ratio == Approx(1.0));
+  CHECK(reg.aspect_ratio == Approx(1.0));
+
+  const auto corner = q_of<3>(ElemType::Tet4, {P(0, 0, 0), P(1, 0, 0), P(0, 1, 0), P(0, 0, 1)});
+  CHECK(corner.min_angle_deg == Approx(54.7356).epsilon(1e-4));
+  CHECK(corner.max_angle_deg == Approx(90.0));
+  CHECK(corner.scaled_jacobian == Approx(std::sqrt(2.0) / 2));  // corner 1: J / (1 sqrt2 sqrt2)
+  CHECK(corner.radius_ratio > 1.0);
+
+  const auto sliver = q_of<3>(ElemType::Tet4, {P(0, 0, 0), P(1, 0, 0), P(0, 1, 0), P(0.5, 0.5, 0.01)});
+  CHECK(sliver.min_angle_deg < 5.0);
+  CHECK(sliver.max_angle_deg > 170.0);
+  CHECK(sliver.radius_ratio > 10.0);
+}
+
+TEST_CASE("hex, prism, pyramid", "[quality]") {
+  using P = Point<3>;
+  const auto hex = q_of<3>(ElemType::Hex8, {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0, 0, 1), P(1, 0, 1), P(1, 1, 1), P(0, 1, 1)});
+  CHECK(hex.scaled_jacobian == Approx(1.0));
+  CHECK(hex.min_angle_deg == Approx(90.0));
+  CHECK(hex.max_angle_deg == Approx(90.0));
+  CHECK(hex.aspect_ratio == Approx(1.0));
+  const double h = std::sqrt(3.0) / 2;
+  const auto prism = q_of<3>(ElemType::Prism6, {P(0, 0, 0), P(1, 0, 0), P(0.5, h, 0), P(0, 0, 1), P(1, 0, 1), P(0.5, h, 1)});
+  CHECK(prism.scaled_jacobian == Approx(1.0));
+  CHECK(prism.min_angle_deg == Approx(60.0));
+  CHECK(prism.max_angle_deg == Approx(90.0));
+  const auto pyr = q_of<3>(ElemType::Pyramid5, {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0.5, 0.5, std::sqrt(0.5))});
+  CHECK(pyr.scaled_jacobian == Approx(1.0));
+  std::vector<P> pv = {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0.5, 0.5, 3)};
+  CHECK(signed_measure<3>(ElemType::Pyramid5, {pv.data(), 5}) == Approx(1.0));
+}
+
+TEMPLATE_TEST_CASE_SIG("summary of a structured grid", "[quality]", ((int Dim), Dim), 2, 3) {
+  for (const bool simplices : {false, true}) {
+    const Mesh<Dim> mesh = test::grid_mesh<Dim>(3, simplices, 0.5);
+    const QualitySummary s = summarize_quality(mesh);
+    const double volume = std::pow(1.5, Dim);
+    CHECK(s.n_elements == mesh.solid.size());
+    CHECK(s.measure == Approx(volume));
+    CHECK(solid_measure(mesh) == Approx(volume));
+    CHECK(interface_enclosed_measure(mesh) == Approx(volume));
+    std::size_t total = 0;
+    for (auto c : s.scaled_jacobian_histogram) total += c;
+    CHECK(total == mesh.solid.size());
+    CHECK(s.min_scaled_jacobian > 0.0);
+    CHECK(s.n_slivers == 0);
+    if (!simplices) {
+      CHECK(s.min_scaled_jacobian == Approx(1.0));
+      CHECK(s.scaled_jacobian_histogram[9] == mesh.solid.size());
+      CHECK(s.min_angle_deg == Approx(90.0));
+    }
+    CHECK(scaled_jacobians<Dim>(mesh.solid, mesh.points).size() == mesh.solid.size());
+  }
+}
+
+TEST_CASE("slivers are counted below the dihedral threshold", "[quality]") {
+  Mesh<3> m;
+  using P = Point<3>;
+  for (const P& p : {P(0, 0, 0), P(1, 0, 0), P(0, 1, 0), P(0.5, 0.5, 0.01)}) m.add_point(p);
+  m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{1}, VertexId{2}, VertexId{3}});
+  CHECK(summarize_quality(m, 10.0).n_slivers == 1);
+  CHECK(summarize_quality(m, 0.1).n_slivers == 0);
+}

@@ -1,0 +1,124 @@
+// core/smooth.hpp: the guard never lets an element invert or the minimum quality drop.
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+
+#include "core/quality.hpp"
+#include "core/smooth.hpp"
+#include "core/validate.hpp"
+#include "property.hpp"
+#include "test_mesh_fixtures.hpp"
+
+using namespace febemesh;
+
+namespace {
+
+template <int Dim> bool on_grid_boundary(const Point<Dim>& p, double size) {
+  for (int d = 0; d < Dim; ++d)
+    if (p[d] == 0.0 || p[d] == size) return true;
+  return false;
+}
+
+/// Interior nodes of an n-grid moved by up to `amount` cell sizes, deterministic in `seed`.
+template <int Dim> Mesh<Dim> perturbed(int n, bool simplices, double amount, unsigned seed) {
+  Mesh<Dim> mesh = test::grid_mesh<Dim>(n, simplices);
+  unsigned s = seed * 2654435761u + 12345u;
+  auto next = [&] {
+    s = s * 1664525u + 1013904223u;
+    return (s >> 8) / double(1 << 24) * 2.0 - 1.0;
+  };
+  for (auto& p : mesh.points)
+    if (!on_grid_boundary<Dim>(p, n))
+      for (int d = 0; d < Dim; ++d) p[d] += amount * next();
+  return mesh;
+}
+
+template <int Dim> double min_quality(const Mesh<Dim>& m) {
+  const auto q = scaled_jacobians<Dim>(m.solid, m.points);
+  return *std::min_element(q.begin(), q.end());
+}
+
+}  // namespace
+
+TEMPLATE_TEST_CASE_SIG("smoothing improves a perturbed grid and keeps the boundary", "[smooth]", ((int Dim), Dim), 2, 3) {
+  for (const bool simplices : {false, true}) {
+    Mesh<Dim> mesh = perturbed<Dim>(4, simplices, 0.3, 7);
+    REQUIRE(is_valid(mesh));
+    const Mesh<Dim> before = mesh;
+    const SmoothStats stats = smooth(mesh);
+    CHECK(stats.iterations == 4);
+    CHECK(stats.moves_accepted > 0);
+    CHECK(stats.min_quality_after >= stats.min_quality_before);
+    CHECK(stats.min_quality_after == min_quality(mesh));
+    CHECK(min_quality(mesh) > min_quality(before));
+    for (std::size_t i = 0; i < mesh.points.size(); ++i)
+      if (on_grid_boundary<Dim>(before.points[i], 4)) CHECK(mesh.points[i] == before.points[i]);
+    CHECK(is_valid(mesh));
+  }
+}
+
+TEMPLATE_TEST_CASE_SIG("fixed nodes do not move", "[smooth]", ((int Dim), Dim), 2, 3) {
+  Mesh<Dim> mesh = perturbed<Dim>(3, true, 0.2, 3);
+  const Mesh<Dim> before = mesh;
+  SmoothOptions<Dim> opt;
+  opt.fixed.assign(mesh.points.size(), 1);
+  const SmoothStats stats = smooth(mesh, opt);
+  CHECK(stats.moves_accepted == 0);
+  CHECK(mesh.points == before.points);
+}
+
+TEMPLATE_TEST_CASE_SIG("boundary nodes slide with a projection", "[smooth]", ((int Dim), Dim), 2, 3) {
+  const int n = 4;
+  Mesh<Dim> mesh = test::grid_mesh<Dim>(n, true);
+  // Crowd the boundary nodes of the lower facet towards x = 0 (stay on the facet).
+  for (auto& p : mesh.points)
+    if (p[1] == 0.0 && p[0] > 0.0 && p[0] < n) p[0] *= 0.5;
+  REQUIRE(is_valid(mesh));
+  const double q_before = min_quality(mesh);
+  // Projection onto the nearest facet of the box [0, n]^Dim.
+  auto project = [n](const Point<Dim>& p) {
+    Point<Dim> q = p.cwiseMax(0.0).cwiseMin(double(n));
+    int best = 0;
+    double dist = 1e300;
+    for (int d = 0; d < Dim; ++d)
+      for (const double side : {0.0, double(n)})
+        if (std::abs(q[d] - side) < dist) dist = std::abs(q[d] - side), best = 2 * d + (side > 0);
+    q[best / 2] = best % 2 ? n : 0.0;
+    return q;
+  };
+  SmoothOptions<Dim> opt;
+  opt.project = project;
+  opt.fixed.assign(mesh.points.size(), 0);
+  for (std::size_t i = 0; i < mesh.points.size(); ++i) {  // box corners and edges stay
+    int on = 0;
+    for (int d = 0; d < Dim; ++d) on += mesh.points[i][d] == 0.0 || mesh.points[i][d] == n;
+    opt.fixed[i] = on >= 2;
+  }
+  smooth(mesh, opt);
+  ValidateOptions<Dim> vopt;
+  vopt.boundary_distance = [&](const Point<Dim>& p) { return (project(p) - p).norm(); };
+  vopt.boundary_tolerance = 1e-12;
+  const ValidationReport r = validate(mesh, vopt);
+  INFO(r.summary());
+  CHECK(r.valid);
+  CHECK(min_quality(mesh) > q_before);
+}
+
+TEMPLATE_TEST_CASE_SIG("smoothing never inverts an element", "[smooth][property]", ((int Dim), Dim), 2, 3) {
+  febemesh::test::prop("no inversion, no quality drop", 40, [](unsigned seed, bool simplices) {
+    const double amount = *rc::gen::inRange(5, 60) / 100.0;  // up to 0.6 cells: folded meshes too
+    Mesh<Dim> mesh = perturbed<Dim>(3, simplices, amount, seed);
+    std::vector<char> was_valid;
+    for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+      const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+      was_valid.push_back(min_corner_jacobian<Dim>(mesh.solid.type[e], ep.span()) > 0.0);
+    }
+    const SmoothStats stats = smooth(mesh);
+    RC_ASSERT(stats.min_quality_after >= stats.min_quality_before);
+    for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+      const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+      if (was_valid[e]) RC_ASSERT(min_corner_jacobian<Dim>(mesh.solid.type[e], ep.span()) > 0.0);
+    }
+  });
+}
