@@ -35,20 +35,28 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
     const Triangle& tr = surface_.triangle(t);
     centroid[t] = (surface_.vertex(tr[0]) + surface_.vertex(tr[1]) + surface_.vertex(tr[2])) / 3.0;
   }
+  // Curvature across each smooth edge (bending angle over the centroid distance), averaged at
+  // the vertices, then over the triangle's vertices: single edges of irregular meshes are noisy
+  // and the level field takes a maximum, so an average keeps outliers from driving it.
+  std::vector<double> kappa_sum(surface_.n_vertices(), 0.0);
+  std::vector<int> kappa_count(surface_.n_vertices(), 0);
+  for (std::int32_t e = 0; e < surface_.n_edges(); ++e) {
+    if (features_.is_feature_edge(e)) continue;
+    const auto tris = surface_.edge_triangles(e);
+    const double gap = (centroid[tris[0]] - centroid[tris[1]]).norm();
+    if (!(gap > 0.0)) continue;
+    for (std::int32_t v : surface_.edge(e)) {
+      kappa_sum[v] += features_.dihedral(e) / gap;
+      ++kappa_count[v];
+    }
+  }
   for (std::int32_t t = 0; t < nt; ++t) {
     double kappa = 0.0;
     for (int i = 0; i < 3; ++i) {
-      const std::int32_t e = surface_.triangle_edge(t, i);
-      if (features_.is_feature_edge(e)) {
-        near_feature_[t] = true;
-        continue;
-      }
-      const std::int32_t u = surface_.opposite_triangle(e, t);
-      const double gap = (centroid[u] - centroid[t]).norm();
-      if (gap > 0.0) kappa = std::max(kappa, features_.dihedral(e) / gap);
+      const std::int32_t v = surface_.triangle(t)[i];
+      if (kappa_count[v] > 0) kappa += kappa_sum[v] / kappa_count[v] / 3.0;
+      if (features_.is_feature_edge(surface_.triangle_edge(t, i)) || features_.is_corner(v)) near_feature_[t] = true;
     }
-    for (std::int32_t v : surface_.triangle(t))
-      if (features_.is_corner(v)) near_feature_[t] = true;
     if (kappa > 0.0) curvature_level_[t] = std::log2(root_side * kappa / options_.arc);
   }
 }

@@ -7,8 +7,9 @@
 //   - global + feature_extra_levels where the box meets a triangle touching a feature edge or
 //     corner,
 //   - the curvature level of every triangle the box meets: log2(root side * kappa / arc), so
-//     that a cell spans at most `arc` radians of the surface's bending; kappa of a triangle is
-//     the largest dihedral angle / centroid distance over its non-feature edges,
+//     that a cell spans at most `arc` radians of the surface's bending; kappa of an edge is its
+//     dihedral angle / the distance between its triangles' centroids (smooth edges only),
+//     averaged at each vertex, and a triangle's kappa is the mean of its vertices',
 // capped by max_level (set_max_level).
 
 #include <string>
