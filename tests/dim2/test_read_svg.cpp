@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "dim2/curve_boundary.hpp"
 #include "dim2/read_domain.hpp"
 #include "dim2/read_svg.hpp"
 #include "dim2/svg_path.hpp"
@@ -178,6 +179,7 @@ TEST_CASE("every shared glyph reads and its area matches an independent computat
     if (e.path().extension() == ".svg") files.push_back(e.path().string());
   std::sort(files.begin(), files.end());
   REQUIRE(files.size() >= 8);
+  double worst_rel = 0;
   for (const auto& f : files) {
     INFO(f);
     const Domain dom = read_domain(f);
@@ -192,7 +194,12 @@ TEST_CASE("every shared glyph reads and its area matches an independent computat
       for (std::size_t i = 0; i < l.n_pieces(); ++i) CHECK(l.pieces[i][3] == l.pieces[(i + 1) % l.n_pieces()][0]);
     }
     CHECK(n_outer == 1);  // each glyph is one component
+    // the curve kernel's B-spline area (its own exact quadrature, after its own orientation)
+    const CurveBoundary cb(dom);
+    CHECK(std::abs(cb.area() - ref) <= 1e-9 * ref);
+    worst_rel = std::max(worst_rel, std::abs(cb.area() - ref) / ref);
   }
+  WARN("largest relative area difference, B-spline vs independent: " << worst_rel);
 }
 
 TEST_CASE("glyph topology: holes, corners and smooth joins", "[svg][data]") {
