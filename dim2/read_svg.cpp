@@ -296,9 +296,11 @@ class SvgReader {
 
     Domain dom;
     dom.source = source_;
-    for (const auto& s : shapes_) {
+    std::vector<std::vector<Candidate>> all(shapes_.size());
+    for (std::size_t si = 0; si < shapes_.size(); ++si) {
+      const Shape& s = shapes_[si];
       const Affine m = flip * s.transform;
-      std::vector<Candidate> cands;
+      std::vector<Candidate>& cands = all[si];
       for (std::size_t k = 0; k < s.subpaths.size(); ++k) {
         const Subpath& sp = s.subpaths[k];
         Candidate c;
@@ -338,24 +340,37 @@ class SvgReader {
         c.probe = eval(c.pieces[longest], 0.5);
         cands.push_back(std::move(c));
       }
-      // Which side of each subpath is solid? Just inside it the winding number is the others'
-      // winding plus its own orientation; just outside, the others' alone. It bounds the solid
-      // only if the fill rule fills one side and not the other.
-      auto filled = [&](int w) { return s.rule == FillRule::EvenOdd ? (w % 2 != 0) : (w != 0); };
-      for (std::size_t i = 0; i < cands.size(); ++i) {
-        int others = 0;
-        for (std::size_t j = 0; j < cands.size(); ++j)
-          if (j != i) others += winding(cands[j].polyline, cands[i].probe);
-        const int own = cands[i].area > 0 ? 1 : -1;
-        const bool in = filled(others + own), out = filled(others);
+    }
+    // Which side of each subpath is solid? Just inside it the winding number of its shape is the
+    // other subpaths' winding plus its own orientation; just outside, the others' alone. It
+    // bounds the shape only if the fill rule fills one side and not the other; it bounds the
+    // drawing (the union of the shapes) only if no other shape covers it. Shapes are assumed not
+    // to cross each other (the curve kernel refuses intersecting loops).
+    auto filled = [](FillRule rule, int w) { return rule == FillRule::EvenOdd ? (w % 2 != 0) : (w != 0); };
+    auto shape_winding = [&](std::size_t si, const P2& p, std::size_t skip) {
+      int w = 0;
+      for (std::size_t j = 0; j < all[si].size(); ++j)
+        if (j != skip) w += winding(all[si][j].polyline, p);
+      return w;
+    };
+    for (std::size_t si = 0; si < shapes_.size(); ++si) {
+      for (std::size_t i = 0; i < all[si].size(); ++i) {
+        const Candidate& c = all[si][i];
+        const int others = shape_winding(si, c.probe, i);
+        const int own = c.area > 0 ? 1 : -1;
+        const bool in = filled(shapes_[si].rule, others + own), out = filled(shapes_[si].rule, others);
         if (in == out) continue;  // both sides alike: not a boundary of the solid
-        std::vector<Bezier> pieces = cands[i].pieces;
+        bool covered = false;
+        for (std::size_t sj = 0; sj < shapes_.size() && !covered; ++sj)
+          if (sj != si) covered = filled(shapes_[sj].rule, shape_winding(sj, c.probe, all[sj].size()));
+        if (covered) continue;  // inside another shape's solid: the union has no boundary here
+        std::vector<Bezier> pieces = c.pieces;
         const bool want_ccw = in;  // solid inside: outer boundary; else a hole
-        if (want_ccw != (cands[i].area > 0)) {
+        if (want_ccw != (c.area > 0)) {
           std::reverse(pieces.begin(), pieces.end());
           for (auto& b : pieces) std::reverse(b.begin(), b.end());
         }
-        dom.loops.push_back(loop_from_beziers(std::move(pieces), cands[i].name));
+        dom.loops.push_back(loop_from_beziers(std::move(pieces), c.name));
       }
     }
     if (dom.loops.empty()) throw InputError(source_ + ": no geometry: no shape encloses a solid region");
@@ -365,7 +380,15 @@ class SvgReader {
 
 }  // namespace
 
-Domain parse_svg(const std::string& text, const std::string& source) { return SvgReader(text, source).read(); }
+Domain parse_svg(const std::string& text, const std::string& source) {
+  try {
+    return SvgReader(text, source).read();
+  } catch (const InputError& e) {
+    // The curve kernel names the loop but not the file.
+    if (std::string_view(e.what()).substr(0, source.size()) != source) throw InputError(source + ": " + e.what());
+    throw;
+  }
+}
 
 Domain read_svg(const std::string& path) { return parse_svg(read_text_file(path), path); }
 

@@ -380,6 +380,13 @@ TEST_CASE("fill rules decide what is solid", "[svg][fill]") {
   const Domain three = read(same + "M4 4H6V6H4Z", "evenodd");
   CHECK(three.loops.size() == 3);
   CHECK(domain_area(three) == Approx(100 - 36 + 4));
+  // separate elements paint their union: a circle on a plate adds nothing, an island in a hole does
+  const Domain onto = parse_svg(svg_doc("<rect width='10' height='10'/><circle cx='5' cy='5' r='2'/>"), "u.svg");
+  CHECK(onto.loops.size() == 1);
+  CHECK(domain_area(onto) == Approx(100));
+  const Domain island = parse_svg(svg_doc("<path fill-rule='evenodd' d='" + same + "'/><rect x='4' y='4' width='2' height='2'/>"), "u.svg");
+  CHECK(island.loops.size() == 3);
+  CHECK(domain_area(island) == Approx(100 - 36 + 4));
 }
 
 TEST_CASE("unrendered containers are ignored", "[svg]") {
