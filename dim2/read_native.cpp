@@ -148,7 +148,13 @@ Domain parse_native(const std::string& text, const std::string& source, NativeOp
   } catch (const json::exception& e) {
     throw InputError(source + ": malformed JSON: " + e.what());
   }
-  return NativeReader(source).read(doc, options);
+  try {
+    return NativeReader(source).read(doc, options);
+  } catch (const InputError& e) {
+    // The curve kernel names the loop but not the file.
+    if (std::string_view(e.what()).substr(0, source.size()) != source) throw InputError(source + ": " + e.what());
+    throw;
+  }
 }
 
 Domain read_native(const std::string& path, NativeOptions* options) {

@@ -265,7 +265,11 @@ Domain parse_poly(const std::string& text, const std::string& source, const std:
                        " lies inside the solid but no hole point marks it (Triangle would mesh it as solid; add a hole point)");
     // Solid on the left: outer boundaries counter-clockwise, holes clockwise.
     if ((shoelace(polys[i]) > 0) == is_hole) std::reverse(polys[i].begin(), polys[i].end());
-    dom.loops.push_back(loop_from_polygon(polys[i], "loop " + std::to_string(i + 1)));
+    try {
+      dom.loops.push_back(loop_from_polygon(polys[i], "loop " + std::to_string(i + 1)));
+    } catch (const InputError& e) {
+      throw InputError(where(source, polys[i].front()) + e.what());  // the kernel names the loop, not the file
+    }
   }
   return dom;
 }
