@@ -129,6 +129,7 @@ int run(const std::vector<std::string>& argv) {
                    {"surface_nodes", r.stats.n_surface_nodes},
                    {"shared_projections", r.stats.n_shared_projections},
                    {"next_normal", r.stats.n_next_normal},
+                   {"ray_projections", r.stats.n_ray},
                    {"corners_snapped", r.stats.n_corners_snapped},
                    {"corners_missed", r.stats.n_corners_missed},
                    {"edge_nodes_snapped", r.stats.n_edge_snapped},

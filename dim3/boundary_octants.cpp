@@ -185,6 +185,78 @@ struct Projector {
   }
 };
 
+/// Inserts the free faces' corners missing from `nodes` (keeping points sorted by key).
+void add_face_corners(LatticeNodes<3>& nodes, const std::vector<FreeFacet<3>>& facets) {
+  std::vector<std::uint64_t> extra;
+  for (const FreeFacet<3>& f : facets)
+    for (const LP& p : f.corners())
+      if (nodes.find(p) < 0) extra.push_back(point_key<3>(p));
+  if (extra.empty()) return;
+  for (const LP& p : nodes.points) extra.push_back(point_key<3>(p));
+  std::sort(extra.begin(), extra.end());
+  extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
+  nodes.points.clear();
+  for (std::uint64_t k : extra) nodes.points.push_back(point_from_key<3>(k));
+  nodes.hanging.assign(nodes.points.size(), 0);  // not used past this point
+  nodes.leaf_corners.clear();
+}
+
+/// First surface point along a ray from q (Moller-Trumbore against the triangles on the
+/// segment), or false.
+bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit) {
+  double best = std::numeric_limits<double>::infinity();
+  const P3 d = end - q;
+  s.tree().for_each_on_segment(q, end, [&](std::int32_t t) {
+    const auto& v = s.tree().points(t);
+    const P3 e1 = v[1] - v[0], e2 = v[2] - v[0];
+    const P3 pv = d.cross(e2);
+    const double det = e1.dot(pv);
+    if (std::abs(det) < 1e-300) return;
+    const P3 tv = q - v[0];
+    const double u = tv.dot(pv) / det;
+    if (u < 0 || u > 1) return;
+    const P3 qv = tv.cross(e1);
+    const double w = d.dot(qv) / det;
+    if (w < 0 || u + w > 1) return;
+    const double tt = e2.dot(qv) / det;
+    if (tt > 0 && tt <= 1 && tt < best) best = tt;
+  });
+  if (!std::isfinite(best)) return false;
+  hit = q + best * d;
+  return true;
+}
+
+/// The paper's "other normals": rays from q along the outward normals of its free faces
+/// (`dirs`, bit f = face f) and along their sum; the first admissible surface point.
+bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q, std::uint8_t dirs, double reach,
+                    ClosestPoint<3>& out) {
+  std::vector<P3> rays;
+  P3 sum = P3::Zero();
+  for (int f = 0; f < 6; ++f) {
+    if (!((dirs >> f) & 1)) continue;
+    P3 n = P3::Zero();
+    n[f / 2] = (f % 2) ? 1.0 : -1.0;
+    sum += n;
+  }
+  if (sum.norm() > 0) rays.push_back(sum.normalized());
+  for (int f = 0; f < 6; ++f) {
+    if (!((dirs >> f) & 1)) continue;
+    P3 n = P3::Zero();
+    n[f / 2] = (f % 2) ? 1.0 : -1.0;
+    rays.push_back(n);
+  }
+  for (const P3& dir : rays) {
+    P3 hit;
+    if (!first_hit(s, q, q + reach * dir, hit)) continue;
+    const ClosestPoint<3> cp = s.closest_point(hit);
+    if (!proj.admissible(q, cp.point)) continue;
+    out = cp;
+    out.distance = (cp.point - q).norm();
+    return true;
+  }
+  return false;
+}
+
 /// Feature line segments bucketed on a uniform grid, for "nearest feature line point" queries.
 class FeatureGrid {
  public:
@@ -250,6 +322,11 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   OctantComplexResult res;
   OctantComplex& oc = res.complex;
   oc.lattice = lattice_nodes(t, &in);
+  const std::vector<FreeFacet<3>> facets = free_facets(t, in);
+  // A sub-face left by an unkept finer neighbour may have corners that are no kept octant's
+  // corner (the middle of a coarse edge): they become nodes too, so that the faces around them
+  // (templates, boundary octants) all see them.
+  add_face_corners(oc.lattice, facets);
   const std::int32_t n_lat = oc.n_lattice();
   oc.points.reserve(n_lat);
   for (const LP& p : oc.lattice.points) oc.points.push_back(position(t, p));
@@ -258,9 +335,9 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   for (std::size_t i = 0; i < t.n_leaves(); ++i)
     if (in[i]) oc.interior.push_back(i);
 
-  const std::vector<FreeFacet<3>> facets = free_facets(t, in);
   res.stats.n_free_faces = facets.size();
   std::vector<double> node_h(n_lat, std::numeric_limits<double>::infinity());
+  std::vector<std::uint8_t> node_dirs(n_lat, 0);  // outward axis directions of the free faces
   for (const FreeFacet<3>& f : facets) {
     BoundaryOctant b;
     b.leaf = f.leaf;
@@ -268,7 +345,10 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
     b.face = f.face;
     b.ring = face_ring(oc.lattice, f.cell, f.face, b.corner_slot);
     const double h = face_size(t, f.cell);
-    for (std::int32_t q : b.ring) node_h[q] = std::min(node_h[q], h);
+    for (std::int32_t q : b.ring) {
+      node_h[q] = std::min(node_h[q], h);
+      node_dirs[q] |= std::uint8_t(1u << f.face);
+    }
     oc.boundary.push_back(std::move(b));
   }
 
@@ -280,16 +360,23 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   for (std::int32_t q = 0; q < n_lat; ++q) {
     if (!std::isfinite(node_h[q])) continue;
     ++res.stats.n_face_nodes;
-    const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);
-    std::size_t pick = cands.size();
-    for (std::size_t k = 0; k < cands.size() && pick == cands.size(); ++k)
-      if (proj.admissible(oc.points[q], cands[k].point)) pick = k;
-    if (pick == cands.size()) {
-      res.problems.push_back({oc.points[q], "no admissible projection onto the surface"});
-      continue;
+    ClosestPoint<3> cp = s.closest_point(oc.points[q]);
+    if (!proj.admissible(oc.points[q], cp.point)) {
+      // The next local minima of the distance, then rays along the free faces' normals.
+      const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);
+      std::size_t pick = cands.size();
+      for (std::size_t k = 1; k < cands.size() && pick == cands.size(); ++k)
+        if (proj.admissible(oc.points[q], cands[k].point)) pick = k;
+      if (pick < cands.size()) {
+        cp = cands[pick];
+        ++res.stats.n_next_normal;
+      } else if (ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
+        ++res.stats.n_ray;
+      } else {
+        res.problems.push_back({oc.points[q], "no admissible projection onto the surface"});
+        continue;
+      }
     }
-    if (pick > 0) ++res.stats.n_next_normal;
-    const ClosestPoint<3>& cp = cands[pick];
     const auto key = std::make_tuple(cp.point[0], cp.point[1], cp.point[2]);
     const auto it = by_point.find(key);
     if (it != by_point.end()) {
@@ -372,25 +459,34 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
     std::sort(order.begin(), order.end());
     // Snapped targets on a grid of spacing about a third of the face size, to keep snapped
     // nodes apart.
-    std::vector<P3> taken;
+    std::map<std::array<long, 3>, std::vector<P3>> taken;  // bucketed by h_med
+    const auto bucket = [&](const P3& x) {
+      return std::array<long, 3>{static_cast<long>(std::floor(x[0] / h_med)),
+                                 static_cast<long>(std::floor(x[1] / h_med)),
+                                 static_cast<long>(std::floor(x[2] / h_med))};
+    };
     for (std::int32_t p = n_lat; p < n_pts; ++p)
-      if (oc.snapped[p]) taken.push_back(oc.points[p]);
+      if (oc.snapped[p]) taken[bucket(oc.points[p])].push_back(oc.points[p]);
     for (const auto& [d, p] : order) {
       const P3 target = hit[p].point;
       const double h = surface_h(p);
       bool crowded = false;
-      for (const P3& x : taken)
-        if ((x - target).norm() < 0.3 * h) {
-          crowded = true;
-          break;
-        }
+      const auto c = bucket(target);
+      for (long x = c[0] - 1; x <= c[0] + 1 && !crowded; ++x)
+        for (long y = c[1] - 1; y <= c[1] + 1 && !crowded; ++y)
+          for (long z = c[2] - 1; z <= c[2] + 1 && !crowded; ++z) {
+            const auto it = taken.find({x, y, z});
+            if (it == taken.end()) continue;
+            for (const P3& other : it->second)
+              if ((other - target).norm() < 0.3 * h) crowded = true;
+          }
       if (crowded || !admissible_from_all(p, target)) continue;
       const ClosestPoint<3> on = s.closest_point(target);
       oc.points[p] = target;
       oc.where[p] = on.where;
       oc.where[p].kind = BoundaryLocation::Kind::FeatureEdge;
       oc.snapped[p] = 1;
-      taken.push_back(target);
+      taken[bucket(target)].push_back(target);
       ++res.stats.n_edge_snapped;
     }
   }

@@ -61,6 +61,7 @@ struct BoundaryOctantStats {
   std::size_t n_surface_nodes = 0;   ///< distinct projections
   std::size_t n_shared_projections = 0;
   std::size_t n_next_normal = 0;     ///< projections that took a further local minimum
+  std::size_t n_ray = 0;             ///< projections found along a free face's normal
   std::size_t n_corners_snapped = 0;
   std::size_t n_corners_missed = 0;
   std::size_t n_edge_snapped = 0;
