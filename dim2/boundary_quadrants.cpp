@@ -265,56 +265,109 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       std::ostringstream os;
       os << "the free edges go " << total / n << " times around loop '" << curve.loops()[loop].name
          << "' (a feature thinner than the quadrants)";
-      res.problems.push_back({qc.points[ch.q[0]], os.str()});
+      for (std::int32_t q : ch.q) res.problems.push_back({qc.points[q], os.str()});
       continue;
     }
-    // Keep the order along the curve: forward running maximum, then backward minimum against
-    // the closing node, so that every boundary quadrant has P1 before P2 (or P1 == P2).
+    // Keep the order along the curve. The projections that already advance form the longest
+    // non-decreasing run from the first node (kept as they are); every other node is projected
+    // again onto the part of the curve between its kept neighbours (an order-constrained
+    // closest point), so one far-off projection cannot drag its followers with it.
     std::vector<double> v = u;
-    for (std::size_t k = 1; k < m; ++k) v[k] = std::max(v[k], v[k - 1]);
-    for (std::size_t k = m - 1; k >= 1; --k) v[k] = std::min(v[k], k + 1 < m ? v[k + 1] : u[0] + n);
+    {
+      std::vector<std::size_t> tail_idx, prev(m, m);  // patience sorting for the longest run
+      std::vector<double> tail_val;
+      for (std::size_t k = 1; k < m; ++k) {
+        if (u[k] < u[0] || u[k] > u[0] + n) continue;
+        const std::size_t pos = static_cast<std::size_t>(
+            std::upper_bound(tail_val.begin(), tail_val.end(), u[k]) - tail_val.begin());
+        prev[k] = pos > 0 ? tail_idx[pos - 1] : 0;
+        if (pos == tail_val.size()) {
+          tail_val.push_back(u[k]);
+          tail_idx.push_back(k);
+        } else {
+          tail_val[pos] = u[k];
+          tail_idx[pos] = k;
+        }
+      }
+      std::vector<std::uint8_t> kept(m, 0);
+      kept[0] = 1;
+      for (std::size_t k = tail_idx.empty() ? 0 : tail_idx.back(); k != 0 && k < m; k = prev[k]) kept[k] = 1;
+      for (std::size_t k = 1; k < m; ++k) {
+        if (kept[k]) continue;
+        std::size_t a = k - 1;  // previous kept node (already final: we go forwards)
+        std::size_t b = k + 1;
+        while (b < m && !kept[b]) ++b;
+        const double lo = v[a], hi = b < m ? u[b] : u[0] + n;
+        // Closest point of the curve on [lo, hi] to Q: sampling, then golden-section polish.
+        const Point<2>& q = qc.points[ch.q[k]];
+        auto dist = [&](double t) { return (curve.evaluate(loop, wrap(t, n)) - q).squaredNorm(); };
+        const int samples = 32;
+        double best_t = lo, best_d = dist(lo);
+        for (int s = 1; s <= samples; ++s) {
+          const double t = lo + (hi - lo) * s / samples;
+          const double d = dist(t);
+          if (d < best_d) best_d = d, best_t = t;
+        }
+        double x0 = std::max(lo, best_t - (hi - lo) / samples), x1 = std::min(hi, best_t + (hi - lo) / samples);
+        for (int it = 0; it < 60 && x1 - x0 > 1e-15 * n; ++it) {
+          const double g = 0.381966011250105;
+          const double m1 = x0 + g * (x1 - x0), m2 = x1 - g * (x1 - x0);
+          if (dist(m1) < dist(m2)) x1 = m2; else x0 = m1;
+        }
+        const double t = 0.5 * (x0 + x1);
+        v[k] = dist(t) <= best_d ? std::clamp(t, lo, hi) : best_t;
+      }
+    }
 
-    // Pull the nearest boundary node onto each corner of this loop.
-    std::vector<std::int32_t> corner_at(m, -1);
+    // Corners (paper: pull the boundary nodes near corner points onto them). The corner lies
+    // between the projections of two consecutive chain nodes; the nearer of the two is pulled
+    // onto it when that moves it little, otherwise the corner is inserted between them.
+    std::vector<std::int32_t> corner_at(m, -1);     // corner pulled onto chain node k
+    std::vector<std::int32_t> corner_after(m, -1);  // corner inserted between k and k+1
     if (opt.pull_corners) {
       const auto& corners = curve.corners();
       for (std::size_t ci = 0; ci < corners.size(); ++ci) {
         if (corners[ci].loop != loop) continue;
-        // Corner parameter unwrapped into [v0, v0 + n).
-        double tc = corners[ci].t;
+        double tc = corners[ci].t;  // unwrapped into [v0, v0 + n)
         while (tc < v[0]) tc += n;
         while (tc >= v[0] + n) tc -= n;
-        std::size_t best = 0;
-        double best_d = std::numeric_limits<double>::infinity();
-        for (std::size_t k = 0; k < m; ++k) {
-          for (double shift : {-n, 0.0, n}) {
-            const double d = std::abs(v[k] + shift - tc);
-            if (d < best_d) best_d = d, best = k;
+        std::size_t k = m - 1;  // the span [v[k], v[k+1]] holding tc (the last one wraps)
+        for (std::size_t j = 0; j + 1 < m; ++j)
+          if (v[j] <= tc && tc <= v[j + 1]) {
+            k = j;
+            break;
           }
-        }
-        const double dist = (curve.evaluate(loop, wrap(v[best], n)) - corners[ci].point).norm();
-        if (corner_at[best] >= 0 || dist > opt.corner_pull_radius * h[best] ||
-            !proj.admissible(qc.points[ch.q[best]], corners[ci].point)) {
-          if (opt.corners_may_fail) {
-            ++res.stats.n_corners_missed;
-          } else {
-            res.problems.push_back({corners[ci].point, "no boundary node close enough to pull onto the corner"});
+        const std::size_t kn = (k + 1) % m;
+        const double vkn = kn == 0 ? v[0] + n : v[kn];
+        const double dk = (curve.evaluate(loop, wrap(v[k], n)) - corners[ci].point).norm();
+        const double dkn = (curve.evaluate(loop, wrap(vkn, n)) - corners[ci].point).norm();
+        const std::size_t pick = dk <= dkn ? k : kn;
+        const bool shared = (pick == k && k > 0 && v[k - 1] == v[k]) || (pick == k && k + 1 < m && v[k + 1] == v[k]) ||
+                            (pick == kn && kn + 1 < m && v[kn + 1] == v[kn]) || (pick == kn && kn > 0 && v[kn - 1] == v[kn]);
+        const bool already_there = std::min(dk, dkn) <= 1e-9 * h[pick] && corner_at[pick] < 0;
+        const bool pull = already_there || (std::min(dk, dkn) <= opt.corner_pull_radius * h[pick] &&
+                                            corner_at[pick] < 0 && !shared &&
+                                            proj.admissible(qc.points[ch.q[pick]], corners[ci].point));
+        if (pull) {
+          const double target = pick == kn && kn == 0 ? tc - n : tc;
+          if (already_there) {  // keep coincident projections coincident
+            const double old = v[pick];
+            for (double& x : v)
+              if (x == old) x = target;
           }
-          continue;
+          v[pick] = target;
+          corner_at[pick] = static_cast<std::int32_t>(ci);
+          ++res.stats.n_corners_pulled;
+        } else if (corner_after[k] < 0 && tc != v[k] && tc != vkn) {
+          corner_after[k] = static_cast<std::int32_t>(ci);
+          ++res.stats.n_corners_inserted;
+        } else if (tc == v[k] || tc == vkn) {
+          ++res.stats.n_corners_pulled;  // a projection landed on the corner already
+        } else if (opt.corners_may_fail) {
+          ++res.stats.n_corners_missed;
+        } else {
+          res.problems.push_back({corners[ci].point, "two corners between the same two boundary nodes"});
         }
-        // Bring the corner parameter next to v[best] and clamp neighbours that pass it.
-        double target = tc;
-        for (double shift : {-n, n})
-          if (std::abs(tc + shift - v[best]) < std::abs(target - v[best])) target = tc + shift;
-        v[best] = target;
-        for (std::size_t k = best; k-- > 0;) v[k] = std::min(v[k], target);
-        for (std::size_t k = best + 1; k < m; ++k) v[k] = std::max(v[k], target);
-        corner_at[best] = static_cast<std::int32_t>(ci);
-        ++res.stats.n_corners_pulled;
-      }
-      if (v[m - 1] > v[0] + n) {
-        res.problems.push_back({qc.points[ch.q[0]], "corner pulling reversed the boundary nodes"});
-        continue;
       }
     }
 
@@ -349,6 +402,16 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       if (v[k] != u[k] && corner_at[k] < 0 && !proj.admissible(qc.points[ch.q[k]], p)) {
         res.problems.push_back({qc.points[ch.q[k]], "a projection kept in order crosses an interior quadrant"});
       }
+      // Projections that land on the same point (e.g. both sides of a corner) share a node.
+      const double eps = 1e-9 * h[k];
+      if (k > 0 && (qc.points[pnode[k - 1]] - p).norm() <= eps) {
+        pnode[k] = pnode[k - 1];
+        continue;
+      }
+      if (k > 0 && k + 1 == m && (qc.points[pnode[0]] - p).norm() <= eps) {
+        pnode[k] = pnode[0];
+        continue;
+      }
       pnode[k] = qc.add_node(p, NodeKind::Boundary, w);
     }
 
@@ -357,6 +420,23 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       const FreeFacet<2>& f = facets[ch.facet[k]];
       BoundaryQuadrant b;
       b.node = {ch.q[kn], ch.q[k], pnode[k], pnode[kn]};
+      if (corner_after[k] >= 0 &&
+          (qc.points[pnode[k]] - curve.corners()[corner_after[k]].point).norm() <= 1e-9 * h[k]) {
+        corner_after[k] = -1;  // the projection is the corner already
+      }
+      if (corner_after[k] >= 0 &&
+          (qc.points[pnode[kn]] - curve.corners()[corner_after[k]].point).norm() <= 1e-9 * h[k]) {
+        corner_after[k] = -1;
+      }
+      if (corner_after[k] >= 0) {
+        const auto& c = curve.corners()[corner_after[k]];
+        BoundaryLocation w;
+        w.patch = loop;
+        w.param[0] = c.t;
+        w.kind = BoundaryLocation::Kind::Corner;
+        w.feature = corner_after[k];
+        b.corner = qc.add_node(c.point, NodeKind::Boundary, w);
+      }
       b.leaf = f.leaf;
       b.level = f.cell.level;
       if (b.is_triangle()) ++res.stats.n_triangles;
@@ -368,7 +448,9 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     std::ostringstream os;
     os << "loop '" << curve.loops()[l].name << "' is reached by " << chains_on_loop[l]
        << " chains of interior quadrants instead of one";
-    res.problems.push_back({curve.evaluate(static_cast<int>(l), 0.0), os.str()});
+    const std::size_t n_pieces = curve.loops()[l].n_pieces();
+    for (std::size_t piece = 0; piece < n_pieces; ++piece)
+      for (double u : {0.0, 0.5}) res.problems.push_back({curve.evaluate(static_cast<int>(l), piece + u), os.str()});
   }
   return res;
 }

@@ -30,6 +30,7 @@ struct BoundaryQuadrantStats {
   std::size_t n_clamped = 0;       ///< projections clamped to keep the order along the curve
   std::size_t n_triangles = 0;     ///< boundary quadrants with P1 == P2
   std::size_t n_corners_pulled = 0;
+  std::size_t n_corners_inserted = 0;  ///< corners added between two boundary nodes
   std::size_t n_corners_missed = 0;  ///< corners with no boundary node close enough
 };
 
@@ -55,7 +56,7 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
 
 struct BoundaryQuadrantOptions {
   int max_normals = 4;               ///< local minima tried before walking along the curve
-  double corner_pull_radius = 1.0;   ///< pull a corner onto a node within this many cell sizes
+  double corner_pull_radius = 0.5;   ///< pull a node onto a corner within this many cell sizes
   bool pull_corners = true;
   bool corners_may_fail = false;     ///< at the finest level, leave far corners unpulled
 };

@@ -21,6 +21,8 @@
 //                          to another local minimum of the distance along the boundary, i.e.
 //                          across a thin part, a slot, or to a nearby loop or an acute corner),
 //     capped by max_level() (default 12). Cells away from the curve get level 0.
+//   - with given levels, the thickness rule still applies (features thinner than the quadrants
+//     are refined until resolved), at most 4 levels beyond the given level.
 // Levels are relative to root_box(), the tree's root: the smallest square around
 // bounding_box() enlarged by 5%.
 
@@ -144,6 +146,8 @@ class CurveBoundary final : public Boundary<2> {
   std::vector<std::vector<int>> corner_of_;       ///< [loop][piece] -> corner index or -1
   std::vector<std::vector<int>> level_junctions_;  ///< per loop: junctions with a level, ascending
   std::vector<std::vector<double>> auto_level_;    ///< [loop][piece]
+  std::vector<std::vector<double>> thickness_level_;  ///< [loop][piece]: cells <= half the local thickness
+  static constexpr double thickness_boost = 4.0;     ///< thin features refine at most this far beyond a given level
   Box<2> bbox_;
   double scale_ = 1.0;  ///< largest extent of the bounding box
   double global_level_ = no_level;

@@ -14,7 +14,6 @@ const std::string ink = "#222222";
 const std::string curve_blue = "#1f5fbf";
 const std::string interior_fill = "#dbe9f7";
 const std::string boundary_fill = "#f7d9a8";
-const std::string partial_fill = "#f2f2f2";
 const std::string corner_red = "#c0392b";
 const std::string be_green = "#1e8449";
 
@@ -56,9 +55,7 @@ void draw_complex(SvgCanvas& c, const QuadrantComplex& qc, const std::vector<P2>
   if (show_interior)
     for (const InteriorQuadrant& q : qc.interior) c.polygon(ring_points(pts, q.ring), {interior_fill, ink, 0.5, 1.0});
   for (const BoundaryQuadrant& b : qc.boundary) {
-    std::vector<std::int32_t> ids(b.node.begin(), b.node.end());
-    if (b.is_triangle()) ids.pop_back();
-    c.polygon(ring_points(pts, ids), {boundary_fill, ink, 0.5, 1.0});
+    c.polygon(ring_points(pts, b.polygon()), {boundary_fill, ink, 0.5, 1.0});
   }
 }
 
@@ -136,7 +133,8 @@ std::vector<fs::path> write_stage_figures(const Result2d& r, const CurveBoundary
     draw_complex(c, r.complex, r.complex.points);
     draw_curve(c, curve, 1.0);
     draw_corners(c, curve);
-    caption(c, curve, "after pulling to corners: " + std::to_string(r.stats.n_corners_pulled) + " corners");
+    caption(c, curve, "after pulling to corners: " + std::to_string(r.stats.n_corners_pulled) + " pulled, " +
+                          std::to_string(r.stats.n_corners_inserted) + " inserted");
     save(c, dir, "05-corner-pulling.svg", written);
   }
   {

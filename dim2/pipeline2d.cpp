@@ -167,8 +167,8 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     }
     Flags flags;
     if (last || !mark_around(tree, problems, opt.max_level, flags))
-      throw GeometryError("the boundary quadrants cannot be built even at level " + std::to_string(opt.max_level) +
-                          ": " + describe(problems));
+      throw GeometryError("the boundary quadrants cannot be built after " + std::to_string(r.n_repairs) +
+                          " local refinements (max level " + std::to_string(opt.max_level) + "): " + describe(problems));
     ++r.n_repairs;
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +

@@ -24,7 +24,7 @@ struct Options2d {
   bool slide_boundary = false;       ///< let boundary nodes slide along the curve while smoothing
   double buffer = 0.35;              ///< drop interior quadrants nearer the curve than this x size
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
-  int max_repairs = 8;               ///< local refinements when the construction needs them
+  int max_repairs = 12;              ///< local refinements when the construction needs them
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
   int n_threads = 1;
   bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures

@@ -28,12 +28,22 @@ struct InteriorQuadrant {
 };
 
 /// A boundary quadrant, counter-clockwise: Q2, Q1 (the free edge, reversed), P1, P2 (on the
-/// curve). P1 == P2 makes it a triangle (the paper's coincident projections).
+/// curve). P1 == P2 makes it a triangle (the paper's coincident projections). A corner of the
+/// curve between P1 and P2 that no boundary node could be pulled onto without distorting the
+/// quadrant is inserted as a fifth node between P1 and P2.
 struct BoundaryQuadrant {
   std::array<std::int32_t, 4> node{};  ///< Q2, Q1, P1, P2
+  std::int32_t corner = -1;            ///< node of an inserted corner between P1 and P2, or -1
   std::size_t leaf = 0;                ///< the interior quadrant behind the free edge
   std::uint8_t level = 0;              ///< level of the free edge's cell
   bool is_triangle() const { return node[2] == node[3]; }
+  /// The nodes counter-clockwise: 3, 4 or 5 of them.
+  std::vector<std::int32_t> polygon() const {
+    std::vector<std::int32_t> p{node[0], node[1], node[2]};
+    if (corner >= 0) p.push_back(corner);
+    if (!is_triangle()) p.push_back(node[3]);
+    return p;
+  }
 };
 
 struct QuadrantComplex {

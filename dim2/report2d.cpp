@@ -44,6 +44,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   bq["clamped_to_keep_order"] = r.stats.n_clamped;
   bq["triangles_p1_eq_p2"] = r.stats.n_triangles;
   bq["corners_pulled"] = r.stats.n_corners_pulled;
+  bq["corners_inserted"] = r.stats.n_corners_inserted;
   bq["corners_missed"] = r.stats.n_corners_missed;
   bq["buffer_dropped"] = r.n_buffer_dropped;
   bq["pinches_dropped"] = r.n_pinches_dropped;

@@ -66,6 +66,24 @@ void split_quad(Builder& b, std::int32_t a, std::int32_t c1, std::int32_t c, std
   }
 }
 
+/// A convex-enough polygon (CCW) as the fan, from one of its vertices, whose triangles are all
+/// positive with the best smallest angle (ties: the first vertex).
+void best_fan(Builder& b, const std::vector<std::int32_t>& poly, std::uint8_t level, bool bnd) {
+  const std::size_t n = poly.size();
+  std::size_t best = 0;
+  double best_q = -2.0;
+  for (std::size_t a = 0; a < n; ++a) {
+    double q = 4.0;
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+      const P2 &p0 = b.at(poly[a]), &p1 = b.at(poly[(a + k) % n]), &p2 = b.at(poly[(a + k + 1) % n]);
+      q = std::min(q, cross(p0, p1, p2) > 0 ? min_angle(p0, p1, p2) : -1.0);
+    }
+    if (q > best_q) best_q = q, best = a;
+  }
+  for (std::size_t k = 1; k + 1 < n; ++k)
+    b.tri(poly[best], poly[(best + k) % n], poly[(best + k + 1) % n], level, bnd);
+}
+
 void interior_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
   for (const InteriorQuadrant& q : qc.interior) {
     const auto& r = q.ring;
@@ -87,6 +105,12 @@ void interior_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind)
 void boundary_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
   for (const BoundaryQuadrant& q : qc.boundary) {
     const auto& n = q.node;
+    if (q.corner >= 0) {
+      best_fan(b, q.polygon(), q.level, true);
+      b.out.mesh.interface.add(ElemType::Line2, {vid(n[2]), vid(q.corner)});
+      b.out.mesh.interface.add(ElemType::Line2, {vid(q.corner), vid(n[3])});
+      continue;
+    }
     if (q.is_triangle()) {
       b.tri(n[0], n[1], n[2], q.level, true);
     } else if (kind == ElementKind::Tri) {
