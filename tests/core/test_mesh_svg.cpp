@@ -2,7 +2,6 @@
 
 #include <catch2/catch.hpp>
 
-#include <regex>
 
 #include "core/svg_canvas.hpp"
 

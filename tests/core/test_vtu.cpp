@@ -2,7 +2,6 @@
 
 #include <catch2/catch.hpp>
 
-#include <regex>
 #include <sstream>
 
 #include "core/write_vtu.hpp"
