@@ -137,7 +137,10 @@ std::vector<ClosestPoint<3>> SurfaceBoundary::closest_points(const P3& p, int ma
   };
   const auto first_key = key_of(first.triangle, first.where.region);
   double radius = std::max(2.0 * out[0].distance, 1e-3 * diagonal_);
-  const double max_radius = out[0].distance + 2.0 * diagonal_;
+  // Alternatives much farther than the nearest point are no use to a projection: search up to
+  // max(3 d, d + 5% of the diagonal).
+  const double max_radius = std::max(3.0 * out[0].distance, out[0].distance + 0.05 * diagonal_);
+  radius = std::min(radius, max_radius);
   std::vector<std::tuple<double, std::pair<int, std::int32_t>, ClosestPoint<3>>> minima;
   for (;;) {
     minima.clear();

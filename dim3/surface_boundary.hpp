@@ -42,6 +42,7 @@ class SurfaceBoundary final : public Boundary<3> {
   Side classify(const Box<3>& box) const override;
   bool is_inside(const P3& p) const override;
   ClosestPoint<3> closest_point(const P3& p) const override;
+  /// Local minima of the distance within max(3 d, d + 5% of the diagonal), d = the nearest.
   std::vector<ClosestPoint<3>> closest_points(const P3& p, int max_count) const override;
   bool segment_crosses(const P3& a, const P3& b) const override;
   double control_level(const Box<3>& box) const override;
