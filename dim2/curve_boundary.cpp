@@ -530,6 +530,29 @@ double CurveBoundary::local_thickness(const P2& s) const {
   return std::sqrt(best);
 }
 
+double CurveBoundary::feature_thickness(const P2& s, int loop, int piece) const {
+  const double floor2 = (1e-9 * scale_) * (1e-9 * scale_);
+  const int n = int(domain_.loops[std::size_t(loop)].n_pieces());
+  auto adjacent = [&](const Piece& pc) {
+    if (pc.loop != loop) return false;
+    const int d = std::abs(pc.index - piece);
+    return d <= 1 || d >= n - 1;
+  };
+  double best = inf;
+  std::vector<Candidate> cands;
+  traverse([&](const Box<2>& b) { return box_distance2(b, s) < best; },
+           [&](int r) {
+             const Piece& pc = pieces_[std::size_t(r)];
+             if (adjacent(pc) || box_distance2(pc.box, s) >= best) return;
+             cands.clear();
+             piece_local_minima(r, s, best, cands);
+             junction_minima(r, s, cands);
+             for (const Candidate& c : cands)
+               if (c.d2 > floor2) best = std::min(best, c.d2);
+           });
+  return std::sqrt(best);
+}
+
 void CurveBoundary::compute_automatic_levels() {
   const double root = root_box().extent().x();
   auto level_for = [&](double h) { return h > 0.0 ? std::max(0.0, std::ceil(std::log2(root / h))) : 0.0; };
@@ -542,12 +565,16 @@ void CurveBoundary::compute_automatic_levels() {
     thickness_level_[i].assign(l.n_pieces(), 0.0);
     for (std::size_t k = 0; k < l.n_pieces(); ++k) {
       const Bezier& q = l.pieces[k];
-      double thick_lv = 0.0;
+      double thick_lv = 0.0, feature_lv = 0.0;
       for (int j = 0; j < 8; ++j) {
-        const double thick = local_thickness(bezier_point(q, (j + 0.5) / 8.0));
+        const P2 s = bezier_point(q, (j + 0.5) / 8.0);
+        const double feature = feature_thickness(s, int(i), int(k));
+        if (std::isfinite(feature)) feature_lv = std::max(feature_lv, level_for(0.5 * feature));
+        if (!automatic) continue;
+        const double thick = local_thickness(s);
         if (std::isfinite(thick)) thick_lv = std::max(thick_lv, level_for(0.5 * thick));
       }
-      thickness_level_[i][k] = thick_lv;
+      thickness_level_[i][k] = feature_lv;
       if (!automatic) continue;
       double kmax = 0.0;
       for (int j = 0; j <= 32; ++j) kmax = std::max(kmax, std::abs(bezier_curvature(q, j / 32.0)));

@@ -130,6 +130,9 @@ class CurveBoundary final : public Boundary<2> {
   bool piece_meets_box(int rec, const Box<2>& box) const;
   bool segment_hits(const P2& a, const P2& b, double s_lo, double s_hi) const;
   double local_thickness(const P2& s) const;
+  /// The same, ignoring minima on piece `piece` of `loop` and its two neighbours, so that a
+  /// corner is not taken for a thin feature.
+  double feature_thickness(const P2& s, int loop, int piece) const;
   void compute_automatic_levels();
 
   template <typename NodeTest, typename LeafVisit>
