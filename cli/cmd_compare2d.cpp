@@ -1,0 +1,136 @@
+// febemesh compare2d: our 2D pipeline against Gmsh on the same exact curves (issue 7).
+
+#include <iostream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "cli/args.hpp"
+#include "cli/command.hpp"
+#include "cli/compare_report.hpp"
+#include "core/atomic_output.hpp"
+#include "core/error.hpp"
+#include "dim2/compare_gmsh.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/read_domain.hpp"
+
+namespace febemesh::cli {
+namespace {
+
+using namespace febemesh::dim2;
+
+const char* const help = R"(usage: febemesh compare2d INPUT -o DIR [options]
+
+Meshes INPUT with febemesh (mesh2d, triangles) and with Gmsh (`gmsh -2` on a .geo holding the
+exact cubic Bezier pieces of every loop), choosing Gmsh's mesh size so that its triangle count is
+within the tolerance of ours, and measures both meshes with the same code.
+
+options:
+  -o, --output DIR   output folder (written atomically; replaced if it exists)
+  --level N          febemesh's level at the curve (default: the file's levels, else automatic)
+  --gmsh PROGRAM     the Gmsh program (default: gmsh)
+  --tolerance F      accepted relative difference of the element counts (default 0.2)
+  --iterations N     at most N Gmsh runs to match the count (default 6)
+  --quiet            no progress on stderr
+
+outputs in DIR: mesh.msh (ours), gmsh.geo, gmsh.msh, gmsh.log, comparison.json ({"febemesh": {..},
+"gmsh": {..}}: elements, nodes, wall_seconds, elements_per_second, min_angle_deg, max_angle_deg,
+area_rel_error, hausdorff_rel, ...), comparison.md, min-angle.svg, scaled-jacobian.svg.
+Both tools run single-threaded; our wall time is mesh2d + writing mesh.msh, Gmsh's is its whole
+run as a subprocess. A tool that fails is reported with "ok": false and its message verbatim.
+exit status: 0 both tools meshed, 1 bad input or a tool failed, 2 bad usage.
+)";
+
+nlohmann::ordered_json metrics_json(const MeshMetrics2d& m) {
+  nlohmann::ordered_json j;
+  j["ok"] = m.ok;
+  if (!m.ok) j["error"] = m.error;
+  j["settings"] = m.settings;
+  if (m.ok) {
+    j["elements"] = m.elements;
+    j["nodes"] = m.nodes;
+    j["boundary_edges"] = m.boundary_edges;
+    j["wall_seconds"] = m.wall_seconds;
+    j["elements_per_second"] = m.elements_per_second;
+    j["min_angle_deg"] = m.min_angle_deg;
+    j["max_angle_deg"] = m.max_angle_deg;
+    j["elements_below_30deg"] = m.below_30deg;
+    j["min_scaled_jacobian"] = m.min_scaled_jacobian;
+    j["mean_scaled_jacobian"] = m.mean_scaled_jacobian;
+    j["area_rel_error"] = m.area_rel_error;
+    j["hausdorff_rel"] = m.hausdorff_rel;
+    j["node_distance_rel"] = m.node_distance_rel;
+  }
+  return j;
+}
+
+int run(const std::vector<std::string>& argv) {
+  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--gmsh", "--tolerance", "--iterations"});
+  args.expect_positional({"INPUT"});
+  const std::string input = args.positional()[0];
+  const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
+  if (out.empty()) throw UsageError("missing -o DIR");
+  Options2d opt;
+  opt.level = args.real_or("--level", no_level, 0, 20);
+  opt.keep_stages = false;
+  opt.n_threads = 1;
+  CompareOptions2d copt;
+  copt.gmsh = args.value_or("--gmsh", "gmsh");
+  copt.tolerance = args.real_or("--tolerance", 0.2, 0.01, 1.0);
+  copt.max_iterations = args.int_or("--iterations", 6, 1, 20);
+  const bool quiet = args.has("--quiet");
+
+  CurveBoundary curve(read_domain(input));
+  if (opt.level != no_level) curve.set_global_level(opt.level);
+
+  AtomicOutputDir dir(out);
+  if (!quiet) std::cerr << "compare2d: meshing " << input << " with febemesh and " << copt.gmsh << "\n";
+  const Comparison2d c = compare_with_gmsh(curve, opt, copt, dir.path());
+
+  nlohmann::ordered_json j;
+  j["input"] = input;
+  j["exact_area"] = curve.area();
+  j["febemesh"] = metrics_json(c.febemesh);
+  j["gmsh"] = metrics_json(c.gmsh);
+  j["gmsh"]["mesh_size"] = c.gmsh_size;
+  nlohmann::ordered_json trials = nlohmann::ordered_json::array();
+  for (const auto& [h, n] : c.gmsh_trials) trials.push_back({{"size", h}, {"elements", n}});
+  j["gmsh"]["size_trials"] = trials;
+  if (c.febemesh.ok && c.gmsh.ok)
+    j["element_count_ratio"] = double(c.gmsh.elements) / double(c.febemesh.elements);
+  write_text(dir.file("comparison.json"), j.dump(2) + "\n");
+  write_text(dir.file("comparison.md"),
+             comparison_markdown("febemesh vs Gmsh: " + input, j, {"febemesh", "gmsh"},
+                                 {"elements", "nodes", "boundary_edges", "wall_seconds", "elements_per_second",
+                                  "min_angle_deg", "max_angle_deg", "elements_below_30deg", "min_scaled_jacobian",
+                                  "mean_scaled_jacobian", "area_rel_error", "hausdorff_rel", "node_distance_rel"}));
+  Series angles, jac;
+  for (const auto* m : {&c.febemesh, &c.gmsh}) {
+    const std::string name = m == &c.febemesh ? "febemesh" : "gmsh";
+    if (!m->ok) continue;
+    angles.emplace_back(name, m->element_min_angle_deg);
+    jac.emplace_back(name, m->element_scaled_jacobian);
+  }
+  write_histogram_svg(dir.file("min-angle.svg"), "Smallest angle per element", "degrees", 0.0, 60.0, 30, angles);
+  write_histogram_svg(dir.file("scaled-jacobian.svg"), "Scaled Jacobian per element", "scaled Jacobian", 0.0, 1.0,
+                      25, jac);
+  dir.commit();
+  if (!quiet) {
+    for (const auto* m : {&c.febemesh, &c.gmsh}) {
+      const std::string name = m == &c.febemesh ? "febemesh" : "gmsh";
+      if (m->ok)
+        std::cerr << "compare2d: " << name << ": " << m->elements << " elements, min angle " << m->min_angle_deg
+                  << " deg, " << m->elements_per_second << " elements/s\n";
+      else
+        std::cerr << "compare2d: " << name << " failed: " << m->error << "\n";
+    }
+  }
+  std::cout << out << "\n";
+  return c.febemesh.ok && c.gmsh.ok ? exit_ok : exit_bad_input;
+}
+
+}  // namespace
+
+FEBEMESH_COMMAND(Command{"compare2d", "compare febemesh with Gmsh on a 2D input (tables and histograms)", help, run});
+
+}  // namespace febemesh::cli
