@@ -371,6 +371,24 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       }
     }
 
+    // Projections much closer together than the cell size would give a very short BE element
+    // and a needle triangle: merge each such pair at its parameter midpoint (the boundary
+    // quadrant between them becomes the paper's P1 == P2 triangle). Corners stay where they are.
+    if (opt.merge_fraction > 0) {
+      for (std::size_t k = 0; k + 1 < m; ++k) {
+        if (v[k] == v[k + 1] || corner_at[k] >= 0 || corner_at[k + 1] >= 0 || corner_after[k] >= 0) continue;
+        if (k > 0 && v[k - 1] == v[k]) continue;          // already part of a merged group
+        if (k + 2 < m && v[k + 2] == v[k + 1]) continue;
+        const Point<2> a = curve.evaluate(loop, wrap(v[k], n)), b = curve.evaluate(loop, wrap(v[k + 1], n));
+        if ((a - b).norm() >= opt.merge_fraction * std::min(h[k], h[k + 1])) continue;
+        const double mid = 0.5 * (v[k] + v[k + 1]);
+        const Point<2> pm = curve.evaluate(loop, wrap(mid, n));
+        if (!proj.admissible(qc.points[ch.q[k]], pm) || !proj.admissible(qc.points[ch.q[k + 1]], pm)) continue;
+        v[k] = v[k + 1] = mid;
+        ++res.stats.n_merged;
+      }
+    }
+
     // Boundary nodes: one per distinct parameter along the chain (equal ones are shared).
     std::vector<std::int32_t> pnode(m, -1);
     for (std::size_t k = 0; k < m; ++k) {

@@ -31,6 +31,7 @@ struct BoundaryQuadrantStats {
   std::size_t n_triangles = 0;     ///< boundary quadrants with P1 == P2
   std::size_t n_corners_pulled = 0;
   std::size_t n_corners_inserted = 0;  ///< corners added between two boundary nodes
+  std::size_t n_merged = 0;            ///< pairs of nearly coincident projections merged
   std::size_t n_corners_missed = 0;  ///< corners with no boundary node close enough
 };
 
@@ -58,6 +59,7 @@ struct BoundaryQuadrantOptions {
   int max_normals = 4;               ///< local minima tried before walking along the curve
   double corner_pull_radius = 0.5;   ///< pull a node onto a corner within this many cell sizes
   bool pull_corners = true;
+  double merge_fraction = 0.25;      ///< merge projections closer than this x the cell size
   bool corners_may_fail = false;     ///< at the finest level, leave far corners unpulled
 };
 

@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
+#include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
 
 namespace febemesh::dim2 {
@@ -150,6 +151,14 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
             fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
       }
       clock.lap("smoothing");
+      if (opt.improve_rounds > 0) {
+        say("quality: edge flips and angle-guarded smoothing");
+        std::vector<std::uint8_t> locked(fe.mesh.points.size(), 0);
+        for (std::size_t v = 0; v < fe.where.size(); ++v) locked[v] = fe.where[v].patch >= 0 ? 1 : 0;
+        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds);
+        r.n_flips = is.flips;
+        clock.lap("quality pass");
+      }
       problems = inverted_elements(fe.mesh);
     }
     if (problems.empty()) {

@@ -22,6 +22,7 @@ struct Options2d {
   ElementKind elements = ElementKind::Tri;
   int smoothing_iterations = 4;      ///< the paper recommends about four
   bool slide_boundary = false;       ///< let boundary nodes slide along the curve while smoothing
+  int improve_rounds = 4;            ///< rounds of edge flips + angle-guarded smoothing (0 = paper only)
   double buffer = 0.35;              ///< drop interior quadrants nearer the curve than this x size
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
@@ -51,6 +52,7 @@ struct Result2d {
   int n_repairs = 0;
   std::vector<Problem> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_rejected = 0;
+  std::size_t n_flips = 0;          ///< edge flips of the quality pass
   std::vector<StageTime> times;
 };
 

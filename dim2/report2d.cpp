@@ -45,6 +45,8 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   bq["triangles_p1_eq_p2"] = r.stats.n_triangles;
   bq["corners_pulled"] = r.stats.n_corners_pulled;
   bq["corners_inserted"] = r.stats.n_corners_inserted;
+  bq["projections_merged"] = r.stats.n_merged;
+  bq["edge_flips"] = r.n_flips;
   bq["corners_missed"] = r.stats.n_corners_missed;
   bq["buffer_dropped"] = r.n_buffer_dropped;
   bq["pinches_dropped"] = r.n_pinches_dropped;
@@ -104,6 +106,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   o["smoothing_iterations"] = opt.smoothing_iterations;
   o["slide_boundary"] = opt.slide_boundary;
   o["buffer"] = opt.buffer;
+  o["improve_rounds"] = opt.improve_rounds;
   o["max_level"] = opt.max_level;
   o["max_repairs"] = opt.max_repairs;
   o["threads"] = opt.n_threads;
