@@ -375,6 +375,38 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     // and a needle triangle: merge each such pair at its parameter midpoint (the boundary
     // quadrant between them becomes the paper's P1 == P2 triangle). Corners stay where they are.
     if (opt.merge_fraction > 0) {
+      auto near = [&](std::size_t k, const Point<2>& c) {
+        return (curve.evaluate(loop, wrap(v[k], n)) - c).norm() < opt.merge_fraction * h[k];
+      };
+      for (std::size_t k = 0; k + 1 < m; ++k) {
+        // A projection next to a corner joins the corner.
+        if (corner_at[k] >= 0 && corner_at[k + 1] < 0 && v[k + 1] != v[k] &&
+            (k + 2 >= m || v[k + 2] != v[k + 1]) && near(k + 1, curve.corners()[corner_at[k]].point) &&
+            proj.admissible(qc.points[ch.q[k + 1]], curve.corners()[corner_at[k]].point)) {
+          v[k + 1] = v[k];
+          ++res.stats.n_merged;
+        } else if (corner_at[k + 1] >= 0 && corner_at[k] < 0 && v[k + 1] != v[k] && (k == 0 || v[k - 1] != v[k]) &&
+                   near(k, curve.corners()[corner_at[k + 1]].point) &&
+                   proj.admissible(qc.points[ch.q[k]], curve.corners()[corner_at[k + 1]].point)) {
+          v[k] = v[k + 1];
+          ++res.stats.n_merged;
+        } else if (corner_after[k] >= 0) {
+          const auto& c = curve.corners()[corner_after[k]];
+          double tc = c.t;
+          while (tc < v[k]) tc += n;
+          while (tc > v[k + 1] && tc - n >= v[k]) tc -= n;
+          for (std::size_t j : {k, k + 1}) {
+            const bool alone = (j == 0 || v[j - 1] != v[j]) && (j + 1 >= m || v[j + 1] != v[j]);
+            if (corner_after[k] >= 0 && alone && corner_at[j] < 0 && near(j, c.point) &&
+                proj.admissible(qc.points[ch.q[j]], c.point)) {
+              v[j] = tc;
+              corner_at[j] = corner_after[k];
+              corner_after[k] = -1;
+              ++res.stats.n_merged;
+            }
+          }
+        }
+      }
       for (std::size_t k = 0; k + 1 < m; ++k) {
         if (v[k] == v[k + 1] || corner_at[k] >= 0 || corner_at[k + 1] >= 0 || corner_after[k] >= 0) continue;
         if (k > 0 && v[k - 1] == v[k]) continue;          // already part of a merged group

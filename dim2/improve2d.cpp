@@ -43,7 +43,7 @@ double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) {
   return polygon_min_angle(p.data(), n);
 }
 
-ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds) {
+ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
   ImproveStats st;
   auto mesh_min = [&] {
     double q = 180.0;
@@ -100,7 +100,12 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     }
 
     // ---- guarded smoothing on the smallest angle ----
-    std::vector<std::vector<std::int32_t>> incident(n_nodes), neighbours(n_nodes);
+    std::vector<std::vector<std::int32_t>> incident(n_nodes), neighbours(n_nodes), curve_neighbours(n_nodes);
+    for (std::size_t e = 0; e < m.interface.size(); ++e) {
+      const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+      curve_neighbours[v[0].v].push_back(v[1].v);
+      curve_neighbours[v[1].v].push_back(v[0].v);
+    }
     for (std::size_t e = 0; e < m.solid.size(); ++e) {
       const ElemId id{static_cast<std::int32_t>(e)};
       const int n = m.solid.n_nodes_of(id);
@@ -112,10 +117,12 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
     }
     for (std::size_t v = 0; v < n_nodes; ++v) {
-      if (locked[v] || incident[v].empty()) continue;
-      auto& nb = neighbours[v];
+      const bool sliding = locked[v] == 2 && slide;
+      if ((locked[v] && !sliding) || incident[v].empty()) continue;
+      auto& nb = sliding ? curve_neighbours[v] : neighbours[v];
       std::sort(nb.begin(), nb.end());
       nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+      if (nb.empty()) continue;
       P2 target = P2::Zero();
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
@@ -129,6 +136,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       bool moved = false;
       for (double step : {1.0, 0.5, 0.25}) {
         m.points[v] = saved + step * (target - saved);
+        if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
+        if (m.points[v] == saved) break;
         if (local_min() > old_q + 1e-12) {
           moved = true;
           break;

@@ -6,9 +6,11 @@
 //   - guarded smoothing: a free node moves toward the centroid of its neighbours (full step,
 //     then half, then a quarter) only if the smallest angle of its elements rises.
 // The mesh stays conforming and valid: every accepted change keeps all elements positive.
-// Interface nodes and the interface elements are untouched. Deterministic (fixed orders).
+// Interface elements keep their nodes; interface nodes only slide along the curve (optional).
+// Deterministic (fixed orders).
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -25,7 +27,14 @@ struct ImproveStats {
 /// Smallest corner angle (degrees) of a triangle or quadrilateral; <= 0 when inverted.
 double min_corner_angle_deg(const Mesh<2>& m, std::size_t e);
 
-/// `locked[v]` != 0: node v never moves (interface nodes).
-ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4);
+/// Maps a point near the curve onto it for interface node v, or returns the node's current
+/// position when it must not move there (e.g. onto another loop).
+using SlideFn = std::function<Point<2>(std::int32_t v, const Point<2>& target)>;
+
+/// `locked[v]`: 0 free, 1 never moves (corners), 2 interface node that may slide along the curve
+/// through `slide` (toward the midpoint of its two interface neighbours); without `slide`,
+/// 2 is the same as 1.
+ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
+                          const SlideFn& slide = {});
 
 }  // namespace febemesh::dim2

@@ -154,8 +154,22 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       if (opt.improve_rounds > 0) {
         say("quality: edge flips and angle-guarded smoothing");
         std::vector<std::uint8_t> locked(fe.mesh.points.size(), 0);
-        for (std::size_t v = 0; v < fe.where.size(); ++v) locked[v] = fe.where[v].patch >= 0 ? 1 : 0;
-        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds);
+        for (std::size_t v = 0; v < fe.where.size(); ++v) {
+          if (fe.where[v].patch < 0) continue;
+          locked[v] = fe.where[v].kind == BoundaryLocation::Kind::Corner || !opt.slide_in_quality_pass ? 1 : 2;
+        }
+        // Interface nodes slide along their own loop, landing exactly on the curve.
+        const SlideFn slide = [&](std::int32_t v, const Point<2>& target) {
+          const ClosestPoint<2> cp = curve.closest_point(target);
+          if (cp.where.patch != fe.where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner)
+            return fe.mesh.points[v];
+          fe.where[v] = cp.where;
+          return Point<2>(cp.point);
+        };
+        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide);
+        // A rejected slide left `where` at the tried point: recompute it from the kept position.
+        for (std::size_t v = 0; v < fe.where.size(); ++v)
+          if (locked[v] == 2) fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
         r.n_flips = is.flips;
         clock.lap("quality pass");
       }

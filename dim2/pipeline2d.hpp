@@ -23,6 +23,7 @@ struct Options2d {
   int smoothing_iterations = 4;      ///< the paper recommends about four
   bool slide_boundary = false;       ///< let boundary nodes slide along the curve while smoothing
   int improve_rounds = 4;            ///< rounds of edge flips + angle-guarded smoothing (0 = paper only)
+  bool slide_in_quality_pass = true; ///< the quality pass may slide interface nodes along the curve
   double buffer = 0.35;              ///< drop interior quadrants nearer the curve than this x size
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
