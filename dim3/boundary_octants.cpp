@@ -175,11 +175,12 @@ struct Projector {
   const Orthtree<3>& tree;
   const Flags& in;
   const SurfaceBoundary& surface;
+  double graze = 1e-9;
 
   /// The segment from q to a surface point p enters no interior octant and does not cross the
   /// surface before reaching p.
   bool admissible(const P3& q, const P3& p) const {
-    if (segment_enters_kept(tree, in, q, p)) return false;
+    if (segment_enters_kept(tree, in, q, p, graze)) return false;
     const P3 short_end = q + (1.0 - 1e-7) * (p - q);
     return !surface.segment_crosses(q, short_end);
   }
@@ -201,8 +202,8 @@ void add_face_corners(LatticeNodes<3>& nodes, const std::vector<FreeFacet<3>>& f
   nodes.leaf_corners.clear();
 }
 
-/// First surface point along a ray from q (Moller-Trumbore against the triangles on the
-/// segment), or false.
+}  // namespace
+
 bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit) {
   double best = std::numeric_limits<double>::infinity();
   const P3 d = end - q;
@@ -225,6 +226,8 @@ bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit) {
   hit = q + best * d;
   return true;
 }
+
+namespace {
 
 /// The paper's "other normals": rays from q along the outward normals of its free faces
 /// (`dirs`, bit f = face f) and along their sum; the first admissible surface point.
@@ -354,7 +357,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
-  Projector proj{t, in, s};
+  Projector proj{t, in, s, opt.graze};
   std::map<std::tuple<double, double, double>, std::int32_t> by_point;
   std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
   for (std::int32_t q = 0; q < n_lat; ++q) {
@@ -373,7 +376,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
       } else if (ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
         ++res.stats.n_ray;
       } else {
-        res.problems.push_back({oc.points[q], "no admissible projection onto the surface"});
+        res.problems.push_back({oc.points[q], "no admissible projection onto the surface", true});
         continue;
       }
     }

@@ -71,6 +71,9 @@ struct BoundaryOctantStats {
 struct Problem3 {
   P3 where = P3::Zero();
   std::string what;
+  /// The fix: drop the interior octants touching `where` (a face node that sees no admissible
+  /// surface point: refining does not change the view, giving up the octants does), else refine.
+  bool peel = false;
 };
 
 struct OctantComplexResult {
@@ -89,6 +92,7 @@ std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary&
 
 struct BoundaryOctantOptions {
   int max_normals = 4;               ///< local minima tried per node
+  double graze = 0.05;               ///< a projection segment may cut this fraction of an interior octant's size
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes
   double edge_radius = 0.35;         ///< project nodes within this many face sizes onto a feature line
@@ -96,6 +100,10 @@ struct BoundaryOctantOptions {
 
 OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s,
                                          const BoundaryOctantOptions& opt = {});
+
+/// First surface point on the segment q..end (Moller-Trumbore against the triangles on it), or
+/// false.
+bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit);
 
 /// The ring of a free face: its corners in FaceCorners<3> order with the lattice nodes at edge
 /// midpoints in between; corner_slot receives each corner's position.

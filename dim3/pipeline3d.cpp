@@ -53,6 +53,19 @@ bool mark_around(const Orthtree<3>& t, const std::vector<Problem3>& problems, in
   return any;
 }
 
+/// Drops the kept leaves touching any of `points`; returns how many.
+std::size_t peel(const Orthtree<3>& t, Flags& in, const std::vector<P3>& points) {
+  std::size_t n = 0;
+  for (const P3& p : points) {
+    Box<3> b;
+    b.lo = p.array() - 1e-9 * t.unit();
+    b.hi = p.array() + 1e-9 * t.unit();
+    for (std::size_t j : leaves_in_box(t, b))
+      if (in[j]) in[j] = 0, ++n;
+  }
+  return n;
+}
+
 std::string describe(const std::vector<Problem3>& problems) {
   std::ostringstream os;
   os.precision(6);
@@ -84,6 +97,105 @@ P3 centroid(const Mesh<3>& m, std::size_t e) {
   P3 c = P3::Zero();
   for (int k = 0; k < pts.n; ++k) c += pts.p[k];
   return c / pts.n;
+}
+
+double signed_volume(const P3& a, const P3& b, const P3& c, const P3& d) {
+  return (b - a).dot((c - a).cross(d - a)) / 6.0;
+}
+
+/// Inverted or flat tets among `elems` when node `v` sits at `x` (the others where they are).
+int count_bad(const Mesh<3>& m, const std::vector<std::size_t>& elems, std::int32_t v, const P3& x) {
+  int n = 0;
+  for (std::size_t e : elems) {
+    const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    std::array<P3, 4> p;
+    for (int k = 0; k < 4; ++k) p[k] = nodes[k].v == v ? x : m.points[nodes[k].v];
+    double len = 0.0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) len = std::max(len, (p[a] - p[b]).norm());
+    if (signed_volume(p[0], p[1], p[2], p[3]) <= 1e-12 * len * len * len) ++n;
+  }
+  return n;
+}
+
+/// Surface nodes of inverted tets move to another surface point when that leaves fewer of their
+/// tets inverted: the projection of the mean of their surface neighbours (a smoothed
+/// projection, which unfolds crossed projections), halfway there, or the first surface point
+/// along the mean outward normal of their free faces. Every candidate must stay admissible from
+/// all the face nodes projecting onto it. Returns how many nodes moved.
+std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, OctantComplex& oc,
+                     TetMesh& fe) {
+  const std::int32_t n_lat = oc.n_lattice(), n_pts = static_cast<std::int32_t>(oc.points.size());
+  Mesh<3>& m = fe.mesh;
+  const std::vector<std::size_t> bad = inverted_elements(m);
+  if (bad.empty()) return 0;
+  std::vector<std::vector<std::size_t>> incident(n_pts);
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    for (int k = 0; k < 4; ++k)
+      if (nodes[k].v >= n_lat && nodes[k].v < n_pts) incident[nodes[k].v].push_back(e);
+  }
+  std::vector<std::vector<std::int32_t>> neighbours(n_pts);
+  for (std::size_t f = 0; f < m.interface.size(); ++f) {
+    const VertexId* nodes = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (a != b && nodes[a].v < n_pts && nodes[a].v >= n_lat) neighbours[nodes[a].v].push_back(nodes[b].v);
+  }
+  std::vector<std::vector<std::int32_t>> sources(n_pts);
+  for (std::int32_t q = 0; q < n_lat; ++q)
+    if (oc.projection[q] >= 0) sources[oc.projection[q]].push_back(q);
+  std::vector<P3> normal(n_lat, P3::Zero());
+  for (const BoundaryOctant& b : oc.boundary) {
+    P3 n = P3::Zero();
+    n[b.face / 2] = (b.face % 2) ? 1.0 : -1.0;
+    for (std::int32_t q : b.ring) normal[q] += n;
+  }
+  std::set<std::int32_t> movable;
+  for (std::size_t e : bad) {
+    const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    for (int k = 0; k < 4; ++k)
+      if (nodes[k].v >= n_lat && nodes[k].v < n_pts && !oc.snapped[nodes[k].v]) movable.insert(nodes[k].v);
+  }
+  const auto admissible = [&](std::int32_t p, const P3& x) {
+    for (std::int32_t q : sources[p]) {
+      const P3& from = oc.points[q];
+      if (segment_enters_kept(t, in, from, x, graze)) return false;
+      if (s.segment_crosses(from, from + (1.0 - 1e-7) * (x - from))) return false;
+    }
+    return true;
+  };
+  std::size_t moved = 0;
+  for (std::int32_t p : movable) {
+    int best = count_bad(m, incident[p], p, m.points[p]);
+    if (best == 0) continue;
+    std::vector<ClosestPoint<3>> cands;
+    if (!neighbours[p].empty()) {
+      P3 mean = P3::Zero();
+      for (std::int32_t u : neighbours[p]) mean += m.points[u];
+      mean /= static_cast<double>(neighbours[p].size());
+      cands.push_back(s.closest_point(mean));
+      cands.push_back(s.closest_point(0.5 * (mean + m.points[p])));
+    }
+    for (std::int32_t q : sources[p]) {
+      if (normal[q].squaredNorm() == 0) continue;
+      const double reach = 4.0 * (m.points[p] - oc.points[q]).norm() + 1e-3 * s.root_box().extent()[0];
+      P3 hit;
+      if (first_hit(s, oc.points[q], oc.points[q] + reach * normal[q].normalized(), hit))
+        cands.push_back(s.closest_point(hit));
+    }
+    int pick = -1;
+    for (int c = 0; c < static_cast<int>(cands.size()); ++c) {
+      const int n = count_bad(m, incident[p], p, cands[c].point);
+      if (n < best && admissible(p, cands[c].point)) best = n, pick = c;
+    }
+    if (pick < 0) continue;
+    oc.points[p] = cands[pick].point;
+    oc.where[p] = cands[pick].where;
+    m.points[p] = cands[pick].point;
+    ++moved;
+  }
+  return moved;
 }
 
 }  // namespace
@@ -118,17 +230,23 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     return std::make_pair(P3(cp.point), cp.where);
   };
 
+  std::vector<P3> peel_points;
   for (int attempt = 0;; ++attempt) {
     const bool last = attempt >= opt.max_repairs;
     say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
-    Flags in = interior_flags(classify(tree, s, opt.n_threads));
+    const std::vector<Side> sides = classify(tree, s, opt.n_threads);
+    Flags in = interior_flags(sides);
     r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer);
+    r.n_peeled = peel(tree, in, peel_points);
     r.n_pinches_dropped = remove_pinches(tree, in);
+    say("interior octants: " + std::to_string(r.n_buffer_dropped) + " dropped by the buffer rule, " +
+        std::to_string(r.n_peeled) + " peeled, " + std::to_string(r.n_pinches_dropped) + " for pinches");
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
 
     say("boundary octants: projecting the free faces onto the surface");
     BoundaryOctantOptions bo;
     bo.snap_features = opt.snap_features;
+    bo.graze = opt.graze;
     OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
     clock.lap("boundary octants");
     std::vector<Problem3> problems = oc.problems;
@@ -148,9 +266,15 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
             if (id < static_cast<std::int32_t>(oc.complex.snapped.size()) && oc.complex.snapped[id]) revert.insert(id);
           }
         }
-        if (bad.empty() || revert.empty() || round >= 4) {
-          for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
-          break;
+        if (bad.empty()) break;
+        if (revert.empty()) {
+          const std::size_t moved = round < opt.untangle_rounds ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
+          r.n_untangled += moved;
+          if (moved == 0) {
+            for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
+            break;
+          }
+          continue;
         }
         for (std::int32_t id : revert) {
           oc.complex.points[id] = oc.complex.unsnapped[id];
@@ -180,6 +304,16 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       r.interior = std::move(in);
       r.tree = std::move(tree);
       return r;
+    }
+    if (opt.peel && !last && std::any_of(problems.begin(), problems.end(), [](const Problem3& p) { return p.peel; })) {
+      // Peel first, alone: refining would only move the same blind spot.
+      for (const Problem3& p : problems)
+        if (p.peel) peel_points.push_back(p.where);
+      ++r.n_repairs;
+      r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
+      say("repair " + std::to_string(attempt + 1) + ": dropping the interior octants at " +
+          std::to_string(problems.size()) + " place(s): " + describe(problems));
+      continue;
     }
     Flags flags;
     if (last || !mark_around(tree, problems, max_level, flags))

@@ -24,7 +24,10 @@ struct Options3d {
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
   bool snap_features = true;
-  int max_repairs = 6;               ///< local refinements when the construction needs them
+  bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
+  double graze = 0.05;               ///< projection segments may graze interior octants by this x size
+  int untangle_rounds = 8;           ///< rounds of moving surface nodes of inverted tets
+  int max_repairs = 12;              ///< local refinements when the construction needs them
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
@@ -43,6 +46,8 @@ struct Result3d {
   std::size_t n_leaves_subdivided = 0;
   std::size_t n_buffer_dropped = 0;
   std::size_t n_pinches_dropped = 0;
+  std::size_t n_untangled = 0;       ///< surface node moves that unfolded inverted tets
+  std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes
   std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
   int n_repairs = 0;
   std::vector<Problem3> repaired;    ///< what the repairs were for
