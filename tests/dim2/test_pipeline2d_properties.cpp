@@ -1,0 +1,130 @@
+// Property-based validity of the whole 2D pipeline (issue 5) on random valid domains
+// (domain_generators.hpp: the regime, the shrinking). CI budget: a few dozen cases per property;
+// FEBEMESH_PROPERTY_CASES=10000 runs many more; a failure prints the seed (replay with
+// RC_PARAMS="seed=S") and the shrunk case as a native JSON file, which goes to
+// tests/dim2/regressions/ (replayed by test_regressions.cpp).
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "core/error.hpp"
+#include "core/read_msh.hpp"
+#include "core/write_msh.hpp"
+#include "domain_generators.hpp"
+#include "pipeline_check.hpp"
+#include "property.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim2;
+using febemesh::test::PipelineCase;
+
+namespace {
+
+/// What the cases measured, printed after each property so the numbers behind the quality
+/// bound stay visible.
+struct Tally {
+  long cases = 0;
+  long refused = 0;  ///< GeometryError (counted; the property fails on it in this regime)
+  double min_angle = 180.0, min_sj = 1.0;
+  int max_level = 0;
+  void print(const char* what) const {
+    std::printf("[property] %s: %ld cases, %ld GeometryError, min angle %.3g deg, min scaled Jacobian %.3g, "
+                "levels up to %d\n",
+                what, cases, refused, min_angle, min_sj, max_level);
+  }
+};
+
+test::PipelineOutcome run_case(const PipelineCase& c, Tally& tally) {
+  CurveBoundary curve(test::to_domain(c.domain));
+  ++tally.cases;
+  try {
+    test::PipelineOutcome out = test::run_pipeline(curve, test::to_options(c));
+    tally.min_angle = std::min(tally.min_angle, out.q.min_angle_deg);
+    tally.min_sj = std::min(tally.min_sj, out.q.min_scaled_jacobian);
+    tally.max_level = std::max(tally.max_level, c.domain.level);
+    return out;
+  } catch (const GeometryError& e) {
+    ++tally.refused;
+    RC_FAIL(std::string("GeometryError: ") + e.what());
+  }
+}
+
+/// The validity contract on one output.
+void check_valid(const test::PipelineOutcome& out) {
+  RC_TAG(out.v.valid ? "valid" : "INVALID");
+  if (!out.v.valid) RC_FAIL(out.v.summary());
+  RC_ASSERT(out.r.fe.mesh.interface.size() > 0u);
+  // Interface nodes on the curve within 1e-10 of the size.
+  RC_ASSERT(out.f.max_node_distance_rel <= 1e-10);
+  // FE area == BE polygon area to round-off: a sum of n_solid areas, each exact to a few ulps.
+  const double round_off = 4.0 * std::numeric_limits<double>::epsilon() * double(out.v.n_solid);
+  RC_ASSERT(std::abs(out.f.fe_area - out.f.be_polygon_area) <= round_off * out.f.exact_area);
+  // Quality bound (measured, see the issue note): no element degenerates.
+  RC_ASSERT(out.q.min_scaled_jacobian > 0.0);
+}
+
+void validity_property(ElementKind kind, int ci_cases) {
+  Tally tally;
+  test::prop(std::string("whole pipeline output is valid, ") + name(kind), ci_cases, [&] {
+    const PipelineCase c = *test::gen_pipeline_case(kind);
+    check_valid(run_case(c, tally));
+  });
+  tally.print(name(kind));
+}
+
+}  // namespace
+
+TEST_CASE("pipeline output is valid on random domains (tri)", "[property][pipeline2d]") {
+  validity_property(ElementKind::Tri, 15);
+}
+
+TEST_CASE("pipeline output is valid on random domains (mixed)", "[property][pipeline2d]") {
+  validity_property(ElementKind::Mixed, 15);
+}
+
+TEST_CASE("pipeline output is valid on random domains (quad)", "[property][pipeline2d]") {
+  validity_property(ElementKind::Quad, 15);
+}
+
+TEST_CASE("pipeline is deterministic and its MSH reads back the same", "[property][pipeline2d]") {
+  Tally tally;
+  test::prop("same msh bytes twice; write + read back gives the same mesh", 4, [&] {
+    const PipelineCase c = *test::gen_pipeline_case();
+    const test::PipelineOutcome a = run_case(c, tally);
+    const test::PipelineOutcome b = run_case(c, tally);
+    const std::string msh = msh_string<2>(a.r.fe.mesh);
+    RC_ASSERT(msh == msh_string<2>(b.r.fe.mesh));
+    const Mesh<2> back = parse_msh<2>(msh);
+    const Mesh<2>& m = a.r.fe.mesh;
+    RC_ASSERT(back.points == m.points);  // bit for bit
+    RC_ASSERT(back.solid.type == m.solid.type);
+    RC_ASSERT(back.solid.offset == m.solid.offset);
+    RC_ASSERT(back.solid.node == m.solid.node);
+    RC_ASSERT(back.interface.type == m.interface.type);
+    RC_ASSERT(back.interface.offset == m.interface.offset);
+    RC_ASSERT(back.interface.node == m.interface.node);
+  });
+  tally.print("determinism");
+}
+
+TEST_CASE("the FE area approaches the exact area as the level rises", "[property][pipeline2d]") {
+  Tally tally;
+  test::prop("area error at level L+2 below that at L", 4, [&] {
+    PipelineCase c = *test::gen_pipeline_case(ElementKind::Tri);
+    RC_PRE(c.domain.level <= 7);  // three levels up to 9 keep the CI budget
+    std::vector<double> err;
+    for (int k = 0; k < 3; ++k) {
+      const test::PipelineOutcome out = run_case(c, tally);
+      RC_ASSERT(out.v.valid);
+      err.push_back(out.f.area_rel_error);
+      ++c.domain.level;
+    }
+    RC_LOG() << "area errors " << err[0] << " " << err[1] << " " << err[2] << "\n";
+    RC_ASSERT(err[2] <= std::max(err[0], err[1]) / 2.0 + 1e-12);
+  });
+  tally.print("area convergence");
+}

@@ -1,0 +1,56 @@
+#pragma once
+// What each fuzz target does with one input, shared by the libFuzzer targets (tests/fuzz) and
+// the unit test that replays the inputs they found (tests/dim2/test_fuzz_regressions.cpp).
+// InputError is the expected outcome of bad input and is swallowed here; any other exception
+// escapes (the fuzz driver turns it into a crash), as do crashes and sanitizer reports.
+
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "core/error.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/read_native.hpp"
+#include "dim2/read_poly.hpp"
+#include "dim2/read_svg.hpp"
+#include "dim3/read_surface.hpp"
+
+namespace febemesh::fuzz {
+
+/// Accepted domains also go through CurveBoundary (the whole-input checks), as the CLI does.
+inline void check_domain_input(const dim2::Domain& d) { (void)dim2::CurveBoundary(d); }
+
+inline void svg_input(std::string_view data) {
+  try {
+    check_domain_input(dim2::parse_svg(std::string(data), "fuzz.svg"));
+  } catch (const InputError&) {
+  }
+}
+
+inline void native_input(std::string_view data) {
+  try {
+    check_domain_input(dim2::parse_native(std::string(data), "fuzz.json"));
+  } catch (const InputError&) {
+  }
+}
+
+/// The .poly text, then (after the first NUL byte, if any) the companion .node text.
+inline void poly_input(std::string_view data) {
+  const std::size_t nul = data.find('\0');
+  const std::string poly(data.substr(0, nul));
+  const std::string node = nul == std::string_view::npos ? std::string() : std::string(data.substr(nul + 1));
+  try {
+    check_domain_input(dim2::parse_poly(poly, "fuzz.poly", node, "fuzz.node"));
+  } catch (const InputError&) {
+  }
+}
+
+inline void off_input(std::string_view data) {
+  std::istringstream in{std::string(data)};
+  try {
+    (void)dim3::read_off(in, "fuzz.off");
+  } catch (const InputError&) {
+  }
+}
+
+}  // namespace febemesh::fuzz
