@@ -375,6 +375,9 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
         ++res.stats.n_next_normal;
       } else if (ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
         ++res.stats.n_ray;
+      } else if (opt.blind_closest) {
+        // Keep the closest point: the untangling of the templates decides (pipeline3d).
+        ++res.stats.n_blind;
       } else {
         res.problems.push_back({oc.points[q], "no admissible projection onto the surface", true});
         continue;

@@ -62,6 +62,7 @@ struct BoundaryOctantStats {
   std::size_t n_shared_projections = 0;
   std::size_t n_next_normal = 0;     ///< projections that took a further local minimum
   std::size_t n_ray = 0;             ///< projections found along a free face's normal
+  std::size_t n_blind = 0;           ///< inadmissible closest points kept (blind_closest)
   std::size_t n_corners_snapped = 0;
   std::size_t n_corners_missed = 0;
   std::size_t n_edge_snapped = 0;
@@ -92,6 +93,7 @@ std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary&
 
 struct BoundaryOctantOptions {
   int max_normals = 4;               ///< local minima tried per node
+  bool blind_closest = true;         ///< no admissible point: keep the closest one, not a Problem
   double graze = 0.05;               ///< a projection segment may cut this fraction of an interior octant's size
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes

@@ -231,6 +231,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   };
 
   std::vector<P3> peel_points;
+  std::size_t n_prev_problems = 0;
   for (int attempt = 0;; ++attempt) {
     const bool last = attempt >= opt.max_repairs;
     say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
@@ -268,7 +269,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
         }
         if (bad.empty()) break;
         if (revert.empty()) {
-          const std::size_t moved = round < opt.untangle_rounds ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
+          const std::size_t moved = round < opt.untangle_rounds + 4 ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
           r.n_untangled += moved;
           if (moved == 0) {
             for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
@@ -315,10 +316,16 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
           std::to_string(problems.size()) + " place(s): " + describe(problems));
       continue;
     }
+    // Refining around inverted elements can add more than it removes (measured on fandisk,
+    // rotor, spool, anchor, elephant): stop as soon as a repair makes things worse.
+    const bool worse = attempt > 0 && problems.size() > n_prev_problems;
+    n_prev_problems = problems.size();
     Flags flags;
-    if (last || !mark_around(tree, problems, max_level, flags))
-      throw GeometryError("the boundary octants cannot be built even at level " + std::to_string(max_level) + ": " +
-                          describe(problems));
+    if (last || worse || !mark_around(tree, problems, max_level, flags))
+      throw GeometryError("the boundary octants cannot be built (" + std::to_string(problems.size()) +
+                          " problem(s) after " + std::to_string(r.n_repairs) + " repair(s)" +
+                          (worse ? ", the last one made it worse" : ", maximum level " + std::to_string(max_level)) +
+                          "): " + describe(problems));
     ++r.n_repairs;
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +

@@ -26,7 +26,7 @@ struct Options3d {
   bool snap_features = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
-  int untangle_rounds = 8;           ///< rounds of moving surface nodes of inverted tets
+  int untangle_rounds = 16;           ///< rounds of moving surface nodes of inverted tets
   int max_repairs = 12;              ///< local refinements when the construction needs them
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)

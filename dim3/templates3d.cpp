@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "core/cube_faces.hpp"
@@ -214,6 +215,30 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     P3 centre = P3::Zero();
     for (std::int32_t v : corners) centre += b.at(v);
     centre /= static_cast<double>(corners.size());
+    // The centroid need not see every face triangle of a sheared octant: try apexes between the
+    // face's centre and the projections' centre and keep the one whose worst cone is best.
+    P3 qc = P3::Zero(), pc = P3::Zero();
+    for (int c = 0; c < 4; ++c) {
+      qc += 0.25 * b.at(bo.ring[bo.corner_slot[c]]);
+      pc += 0.25 * b.at(p[bo.corner_slot[c]]);
+    }
+    const auto worst = [&](const P3& x) {
+      double w = std::numeric_limits<double>::infinity();
+      for (const Tri& q : tris) {
+        if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+        const P3 &a0 = b.at(q[0]), &a1 = b.at(q[1]), &a2 = b.at(q[2]);
+        w = std::min(w, (a2 - a0).dot((a1 - a0).cross(x - a0)));
+      }
+      return w;
+    };
+    double best = worst(centre);
+    if (best <= 0) {
+      for (double a : {0.5, 0.35, 0.65, 0.2, 0.8, 0.1, 0.9}) {
+        const P3 x = (1 - a) * qc + a * pc;
+        const double w = worst(x);
+        if (w > best) best = w, centre = x;
+      }
+    }
     b.cones(tris, centre, bo.cell.level, true, n_interior + static_cast<std::int32_t>(k));
   }
   return std::move(b.out);
