@@ -130,6 +130,8 @@ int run(const std::vector<std::string>& argv) {
                    {"shared_projections", r.stats.n_shared_projections},
                    {"next_normal", r.stats.n_next_normal},
                    {"ray_projections", r.stats.n_ray},
+                   {"blind_projections", r.stats.n_blind},
+                   {"untangle_moves", r.n_untangled},
                    {"corners_snapped", r.stats.n_corners_snapped},
                    {"corners_missed", r.stats.n_corners_missed},
                    {"edge_nodes_snapped", r.stats.n_edge_snapped},
