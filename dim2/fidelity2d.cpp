@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/quality.hpp"
+#include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
 
 namespace febemesh::dim2 {
@@ -17,6 +18,32 @@ double point_segment_distance(const P2& p, const P2& a, const P2& b) {
 }
 
 }  // namespace
+
+double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
+                                         std::size_t* n_exempt) {
+  std::vector<P2> sharp;
+  for (const CurveCorner& c : curve.corners())
+    if (c.angle_deg < sharp_deg) sharp.push_back(c.point);
+  double best = 180.0;
+  std::size_t exempt = 0;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const int n = m.solid.n_nodes_of(id);
+    const VertexId* v = m.solid.nodes(id);
+    double size = 0.0;
+    for (int k = 0; k < n; ++k) size = std::max(size, (m.points[v[k].v] - m.points[v[(k + 1) % n].v]).norm());
+    bool near = false;
+    for (const P2& c : sharp)
+      for (int k = 0; k < n && !near; ++k) near = (m.points[v[k].v] - c).norm() <= 8.0 * size;
+    if (near) {
+      ++exempt;
+      continue;
+    }
+    best = std::min(best, min_corner_angle_deg(m, e));
+  }
+  if (n_exempt) *n_exempt = exempt;
+  return best;
+}
 
 Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int samples) {
   Fidelity2d f;

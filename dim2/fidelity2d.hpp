@@ -19,6 +19,13 @@ struct Fidelity2d {
   double max_node_distance_rel = 0.0;
 };
 
+/// Smallest corner angle (degrees) over the FE elements that lie farther than eight of their own
+/// sizes from every input corner sharper than `sharp_deg` (the quality bar exempts those
+/// corners: no element there can beat the corner's own angle). Also returns how many elements
+/// were exempt through `n_exempt`.
+double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
+                                         std::size_t* n_exempt = nullptr);
+
 /// `samples` curve points per BE edge for the Hausdorff estimate (one-sided from the curve,
 /// which dominates: the BE edges are chords of the curve).
 Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int samples = 16);

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/quality.hpp"
+#include "dim2/fidelity2d.hpp"
 
 namespace febemesh::dim2 {
 
@@ -57,6 +58,9 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   ordered_json quality;
   quality["min_angle_deg"] = q.min_angle_deg;
   quality["max_angle_deg"] = q.max_angle_deg;
+  std::size_t n_exempt = 0;
+  quality["min_angle_away_from_sharp_corners_deg"] = min_angle_away_from_sharp_corners(m, curve, 20.0, &n_exempt);
+  quality["elements_near_sharp_corners"] = n_exempt;
   quality["min_scaled_jacobian"] = q.min_scaled_jacobian;
   quality["mean_scaled_jacobian"] = q.mean_scaled_jacobian;
   quality["max_aspect_ratio"] = q.max_aspect_ratio;
