@@ -453,7 +453,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         res.problems.push_back({qc.points[ch.q[k]], "a projection kept in order crosses an interior quadrant"});
       }
       // Projections that land on the same point (e.g. both sides of a corner) share a node.
-      const double eps = 1e-9 * h[k];
+      const double eps = 1e-6 * h[k];
       if (k > 0 && (qc.points[pnode[k - 1]] - p).norm() <= eps) {
         pnode[k] = pnode[k - 1];
         continue;
