@@ -54,7 +54,7 @@ test::PipelineOutcome run_case(const PipelineCase& c, Tally& tally) {
 }
 
 /// The validity contract on one output.
-void check_valid(const test::PipelineOutcome& out) {
+void check_valid(const test::PipelineOutcome& out, ElementKind kind) {
   RC_TAG(out.v.valid ? "valid" : "INVALID");
   if (!out.v.valid) RC_FAIL(out.v.summary());
   RC_ASSERT(out.r.fe.mesh.interface.size() > 0u);
@@ -63,15 +63,19 @@ void check_valid(const test::PipelineOutcome& out) {
   // FE area == BE polygon area to round-off: a sum of n_solid areas, each exact to a few ulps.
   const double round_off = 4.0 * std::numeric_limits<double>::epsilon() * double(out.v.n_solid);
   RC_ASSERT(std::abs(out.f.fe_area - out.f.be_polygon_area) <= round_off * out.f.exact_area);
-  // Quality bound (measured, see the issue note): no element degenerates.
+  // Quality bound. The paper's templates promise none after smoothing and corner pulling; what
+  // holds, measured over ~1000 random cases at levels 6-8 (issue 5 note): min angle >= 4.3 deg
+  // (tri), 6.7 (mixed), asserted with a margin; quad: only a positive Jacobian (measured min
+  // angle 0.5 deg, scaled Jacobian 2.4e-5: nearly degenerate quads occur).
   RC_ASSERT(out.q.min_scaled_jacobian > 0.0);
+  if (kind != ElementKind::Quad) RC_ASSERT(out.q.min_angle_deg >= 2.0);
 }
 
 void validity_property(ElementKind kind, int ci_cases) {
   Tally tally;
   test::prop(std::string("whole pipeline output is valid, ") + name(kind), ci_cases, [&] {
     const PipelineCase c = *test::gen_pipeline_case(kind);
-    check_valid(run_case(c, tally));
+    check_valid(run_case(c, tally), kind);
   });
   tally.print(name(kind));
 }
