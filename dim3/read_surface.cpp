@@ -38,7 +38,8 @@ Lines content_lines(std::istream& in) {
     ++number;
     const auto hash = line.find('#');
     if (hash != std::string::npos) line.resize(hash);
-    if (line.find_first_not_of(" \t\r\n") == std::string::npos) continue;
+    // Blank = only what split() skips (isspace: \f and \v too), so every kept line has a token.
+    if (line.find_first_not_of(" \t\r\n\f\v") == std::string::npos) continue;
     lines.items.emplace_back(line, number);
   }
   return lines;
