@@ -354,7 +354,8 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       ++r.hanging_nodes;
       problems.add([&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
     };
-    for (const auto& [a, b] : unique_edges(mesh.solid)) {
+    for (const auto& edge : unique_edges(mesh.solid)) {
+      const VertexId a = edge[0], b = edge[1];  // named, not bound: lambdas capture them (clang 14)
       const Point<Dim>&pa = pts[a.v], &pb = pts[b.v];
       const double margin = rel * (pb - pa).norm();
       tree.query(inflated_box<Dim>({pa, pb}, margin), [&](std::int32_t c) {
