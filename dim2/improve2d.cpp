@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <map>
 
 namespace febemesh::dim2 {
 namespace {
@@ -53,31 +52,52 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   st.min_angle_before = mesh_min();
   const std::size_t n_nodes = m.points.size();
 
-  // Interface edges never flip.
-  std::map<std::pair<std::int32_t, std::int32_t>, int> interface_edge;
+  // Interface edges never flip (sorted keys, binary search).
+  using EdgeKey = std::uint64_t;
+  auto key_of = [](std::int32_t a, std::int32_t b) {
+    return (static_cast<EdgeKey>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+  };
+  std::vector<EdgeKey> interface_edge;
   for (std::size_t e = 0; e < m.interface.size(); ++e) {
     const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
-    interface_edge[{std::min(v[0].v, v[1].v), std::max(v[0].v, v[1].v)}] = 1;
+    interface_edge.push_back(key_of(v[0].v, v[1].v));
   }
+  std::sort(interface_edge.begin(), interface_edge.end());
 
+  // Flips are tried only on edges of elements below `good` degrees: the interior templates have
+  // 45 degrees already, so flipping costs little beyond the boundary layer.
+  const double good = 44.0;
+  std::vector<double> angle(m.solid.size());
+  struct HalfEdge {
+    EdgeKey key;
+    std::int32_t elem;
+    int local;
+  };
+  std::vector<HalfEdge> half;
   for (int round = 0; round < rounds; ++round) {
+    for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = min_corner_angle_deg(m, e);
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
-      std::map<std::pair<std::int32_t, std::int32_t>, std::vector<std::pair<std::int32_t, int>>> edges;
+      half.clear();
       for (std::size_t e = 0; e < m.solid.size(); ++e) {
         if (m.solid.type[e] != ElemType::Tri3) continue;
         const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
-        for (int k = 0; k < 3; ++k) {
-          const std::int32_t a = v[k].v, b = v[(k + 1) % 3].v;
-          edges[{std::min(a, b), std::max(a, b)}].push_back({static_cast<std::int32_t>(e), k});
-        }
+        for (int k = 0; k < 3; ++k)
+          half.push_back({key_of(v[k].v, v[(k + 1) % 3].v), static_cast<std::int32_t>(e), k});
       }
+      std::sort(half.begin(), half.end(), [](const HalfEdge& x, const HalfEdge& y) {
+        return x.key != y.key ? x.key < y.key : x.elem < y.elem;
+      });
       std::vector<std::uint8_t> touched(m.solid.size(), 0);
       std::size_t flips = 0;
-      for (const auto& [key, uses] : edges) {
-        if (uses.size() != 2 || interface_edge.count(key)) continue;
-        const auto [e0, k0] = uses[0];
-        const auto [e1, k1] = uses[1];
+      for (std::size_t h = 0; h + 1 < half.size(); ++h) {
+        if (half[h].key != half[h + 1].key || (h > 0 && half[h - 1].key == half[h].key) ||
+            (h + 2 < half.size() && half[h + 2].key == half[h].key))
+          continue;  // a boundary edge, or (never in a valid mesh) an edge of 3+ triangles
+        const std::int32_t e0 = half[h].elem, e1 = half[h + 1].elem;
+        const int k0 = half[h].local, k1 = half[h + 1].local;
+        if (angle[e0] >= good && angle[e1] >= good) continue;
+        if (std::binary_search(interface_edge.begin(), interface_edge.end(), half[h].key)) continue;
         if (touched[e0] || touched[e1]) continue;
         VertexId* v0 = m.solid.node.data() + m.solid.offset[e0];
         VertexId* v1 = m.solid.node.data() + m.solid.offset[e1];
@@ -93,6 +113,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
+        angle[e0] = tri_min_angle(pc, pa, pd);
+        angle[e1] = tri_min_angle(pd, pb, pc);
         ++flips;
       }
       st.flips += flips;
