@@ -16,6 +16,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/distance.hpp"
 #include "core/error.hpp"
 #include "core/quality.hpp"
 #include "core/read_msh.hpp"
@@ -26,13 +27,6 @@ extern char** environ;
 namespace febemesh::dim2 {
 namespace fs = std::filesystem;
 namespace {
-
-double point_segment_distance(const P2& p, const P2& a, const P2& b) {
-  const P2 ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return (p - (a + s * ab)).norm();
-}
 
 /// Uniform bucket grid of segments for nearest-segment queries (exact: rings are searched until
 /// no closer segment can exist).
@@ -69,7 +63,7 @@ class SegmentGrid {
           if (x < 0 || x >= n_[0]) continue;
           if (std::max(std::abs(x - cx), std::abs(y - cy)) != r) continue;
           for (int i : cells_[std::size_t(y) * std::size_t(n_[0]) + std::size_t(x)])
-            best = std::min(best, point_segment_distance(p, segs_[std::size_t(i)].first, segs_[std::size_t(i)].second));
+            best = std::min(best, point_segment_distance<2>(p, segs_[std::size_t(i)].first, segs_[std::size_t(i)].second));
         }
       }
     }

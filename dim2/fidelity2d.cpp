@@ -3,21 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/distance.hpp"
 #include "core/quality.hpp"
 #include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
 
 namespace febemesh::dim2 {
-namespace {
-
-double point_segment_distance(const P2& p, const P2& a, const P2& b) {
-  const P2 ab = b - a;
-  const double l2 = ab.squaredNorm();
-  const double s = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
-  return (p - (a + s * ab)).norm();
-}
-
-}  // namespace
 
 double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
                                          std::size_t* n_exempt) {
@@ -67,7 +58,7 @@ Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int s
     if (d < 0) d += n;
     for (int s = 1; s < samples; ++s) {
       const P2 p = evaluate(loop, wrap_parameter(loop, wa.param[0] + d * s / samples));
-      f.hausdorff = std::max(f.hausdorff, point_segment_distance(p, a, b));
+      f.hausdorff = std::max(f.hausdorff, point_segment_distance<2>(p, a, b));
     }
   }
   for (std::size_t v = 0; v < m.where.size(); ++v) {

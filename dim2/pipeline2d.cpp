@@ -1,11 +1,11 @@
 #include "dim2/pipeline2d.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
 #include "dim2/improve2d.hpp"
@@ -13,47 +13,6 @@
 
 namespace febemesh::dim2 {
 namespace {
-
-class Stopwatch {
- public:
-  explicit Stopwatch(std::vector<StageTime>& out) : out_(out) {}
-  void lap(const std::string& name) {
-    const auto now = std::chrono::steady_clock::now();
-    out_.push_back({name, std::chrono::duration<double>(now - last_).count()});
-    last_ = now;
-  }
-
- private:
-  std::vector<StageTime>& out_;
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-Flags interior_flags(const std::vector<Side>& sides) {
-  Flags in(sides.size());
-  for (std::size_t i = 0; i < sides.size(); ++i) in[i] = sides[i] == Side::In ? 1 : 0;
-  return in;
-}
-
-/// Mark the leaves around each problem for one more subdivision. Returns false when none can
-/// be refined any more (all at max_level).
-bool mark_around(const Orthtree<2>& t, const std::vector<Problem>& problems, int max_level, Flags& flags) {
-  flags.assign(t.n_leaves(), 0);
-  bool any = false;
-  for (const Problem& pr : problems) {
-    const std::size_t i = locate(t, pr.where);
-    const double h = i == no_leaf ? t.unit() * length(t.leaf(0)) : t.unit() * length(t.leaf(i));
-    Box<2> b;
-    b.lo = pr.where.array() - 2.0 * h;
-    b.hi = pr.where.array() + 2.0 * h;
-    for (std::size_t j : leaves_in_box(t, b)) {
-      if (t.leaf(j).level < max_level) {
-        flags[j] = 1;
-        any = true;
-      }
-    }
-  }
-  return any;
-}
 
 std::string describe(const std::vector<Problem>& problems) {
   std::ostringstream os;
@@ -87,7 +46,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     if (progress) progress(s);
   };
   Result2d r;
-  Stopwatch clock(r.times);
+  StageTimer clock(r.times);
   RefineOptions ro;
   ro.max_level = opt.max_level;
   ro.max_leaves = opt.max_cells;
@@ -189,7 +148,9 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       return r;
     }
     Flags flags;
-    if (last || !mark_around(tree, problems, opt.max_level, flags))
+    std::vector<Point<2>> places;
+    for (const Problem& pr : problems) places.push_back(pr.where);
+    if (last || !mark_around<2>(tree, places, 2.0, opt.max_level, flags))
       throw GeometryError("the boundary quadrants cannot be built after " + std::to_string(r.n_repairs) +
                           " local refinements (max level " + std::to_string(opt.max_level) + "): " + describe(problems));
     ++r.n_repairs;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/orthtree.hpp"
+#include "core/stage_timer.hpp"
 #include "dim2/boundary_quadrants.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/templates2d.hpp"
@@ -30,11 +31,6 @@ struct Options2d {
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
   int n_threads = 1;
   bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures
-};
-
-struct StageTime {
-  std::string name;
-  double seconds = 0.0;
 };
 
 struct Result2d {

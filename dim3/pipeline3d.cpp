@@ -7,51 +7,12 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
 
 namespace febemesh::dim3 {
 namespace {
-
-class Stopwatch {
- public:
-  explicit Stopwatch(std::vector<StageTime3>& out) : out_(out) {}
-  void lap(const std::string& name) {
-    const auto now = std::chrono::steady_clock::now();
-    out_.push_back({name, std::chrono::duration<double>(now - last_).count()});
-    last_ = now;
-  }
-
- private:
-  std::vector<StageTime3>& out_;
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
-
-Flags interior_flags(const std::vector<Side>& sides) {
-  Flags in(sides.size());
-  for (std::size_t i = 0; i < sides.size(); ++i) in[i] = sides[i] == Side::In ? 1 : 0;
-  return in;
-}
-
-/// Mark the leaves around each problem for one more subdivision; false when none can be.
-bool mark_around(const Orthtree<3>& t, const std::vector<Problem3>& problems, int max_level, Flags& flags) {
-  flags.assign(t.n_leaves(), 0);
-  bool any = false;
-  for (const Problem3& pr : problems) {
-    const std::size_t i = locate(t, pr.where);
-    const double h = t.unit() * length(t.leaf(i == no_leaf ? 0 : i));
-    Box<3> b;
-    b.lo = pr.where.array() - 1.5 * h;
-    b.hi = pr.where.array() + 1.5 * h;
-    for (std::size_t j : leaves_in_box(t, b)) {
-      if (t.leaf(j).level < max_level) {
-        flags[j] = 1;
-        any = true;
-      }
-    }
-  }
-  return any;
-}
 
 /// Drops the kept leaves touching any of `points`; returns how many.
 std::size_t peel(const Orthtree<3>& t, Flags& in, const std::vector<P3>& points) {
@@ -205,7 +166,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     if (progress) progress(msg);
   };
   Result3d r;
-  Stopwatch clock(r.times);
+  StageTimer clock(r.times);
   const int max_level = opt.max_level >= 0 ? opt.max_level : opt.level + opt.extra_levels + 2;
   s.set_global_level(opt.level);
   s.set_max_level(opt.level + opt.extra_levels);
@@ -321,7 +282,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     const bool worse = attempt > 0 && problems.size() > n_prev_problems;
     n_prev_problems = problems.size();
     Flags flags;
-    if (last || worse || !mark_around(tree, problems, max_level, flags))
+    std::vector<P3> places;
+    for (const Problem3& pr : problems) places.push_back(pr.where);
+    if (last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags))
       throw GeometryError("the boundary octants cannot be built (" + std::to_string(problems.size()) +
                           " problem(s) after " + std::to_string(r.n_repairs) + " repair(s)" +
                           (worse ? ", the last one made it worse" : ", maximum level " + std::to_string(max_level)) +

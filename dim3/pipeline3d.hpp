@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/orthtree.hpp"
+#include "core/stage_timer.hpp"
 #include "dim3/boundary_octants.hpp"
 #include "dim3/surface_boundary.hpp"
 #include "dim3/templates3d.hpp"
@@ -33,10 +34,7 @@ struct Options3d {
   int n_threads = 1;
 };
 
-struct StageTime3 {
-  std::string name;
-  double seconds = 0.0;
-};
+using StageTime3 = StageTime;
 
 struct Result3d {
   Orthtree<3> tree;                  ///< final tree (after repairs)
