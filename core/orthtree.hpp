@@ -84,8 +84,16 @@ enum class BalanceKind : std::uint8_t {
   Full = 1   ///< across facets, edges and corners
 };
 
-/// The coarsest refinement of `t` that is 2:1 balanced. O(n log n).
-template <int Dim> Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind = BalanceKind::Face);
+struct BalanceOptions {
+  std::size_t max_leaves = 200000000;  ///< refuse (LimitError) a result beyond this many leaves
+};
+
+/// The coarsest refinement of `t` that is 2:1 balanced. O(n log n). Throws LimitError, with the
+/// leaf count and memory it would need, when the input or the result has more than
+/// opt.max_leaves leaves; the count is known level by level before the output is allocated.
+template <int Dim>
+Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind = BalanceKind::Face,
+                           const BalanceOptions& opt = {});
 
 // ---- queries ----------------------------------------------------------------------------------
 

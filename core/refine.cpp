@@ -8,9 +8,11 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
-#include <mutex>
+#include <new>
 #include <sstream>
 #include <thread>
+
+#include <sys/mman.h>
 
 #include "core/error.hpp"
 #include "core/orthtree.hpp"
@@ -41,14 +43,73 @@ struct Budget {
   }
 };
 
-/// Appends leaves to one output vector and reports to the budget every few thousand leaves, so
-/// that memory stays bounded by max_leaves plus one batch per thread.
+/// Append-only storage of emitted leaves in blocks mapped straight from the kernel. A growing
+/// std::vector would hold its old and new buffers at once (up to 2x the leaves at the last
+/// doubling, 3x while copying), and blocks from malloc may stay resident after free (glibc raises
+/// its mmap threshold once a large block is freed, and the next blocks then come from an arena
+/// that is not trimmed). Own mappings are released the moment they are unmapped, so draining the
+/// spool into an exactly reserved vector keeps the peak at the leaves plus one block.
+template <int Dim> class LeafSpool {
+ public:
+  LeafSpool() = default;
+  LeafSpool(const LeafSpool&) = delete;
+  LeafSpool& operator=(const LeafSpool&) = delete;
+  LeafSpool(LeafSpool&& o) noexcept : blocks_(std::move(o.blocks_)), fill_(o.fill_), size_(o.size_) {
+    o.blocks_.clear();
+    o.size_ = 0;
+  }
+  ~LeafSpool() { release(); }
+
+  void push(const Cell<Dim>& c) {
+    if (fill_ == per_block) grow();
+    new (blocks_.back() + fill_) Cell<Dim>(c);
+    ++fill_;
+    ++size_;
+  }
+  std::size_t size() const { return size_; }
+  /// Appends the leaves to `out` in order, unmapping each block once it is copied.
+  void drain_into(std::vector<Cell<Dim>>& out) {
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      const std::size_t n = b + 1 == blocks_.size() ? fill_ : per_block;
+      out.insert(out.end(), blocks_[b], blocks_[b] + n);
+      munmap(blocks_[b], block_bytes);
+      blocks_[b] = nullptr;
+    }
+    blocks_.clear();
+    fill_ = per_block;
+    size_ = 0;
+  }
+
+ private:
+  static constexpr std::size_t block_bytes = std::size_t(1) << 20;
+  static constexpr std::size_t per_block = block_bytes / sizeof(Cell<Dim>);
+
+  void grow() {
+    void* p = mmap(nullptr, block_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED) throw std::bad_alloc();
+    blocks_.push_back(static_cast<Cell<Dim>*>(p));
+    fill_ = 0;
+  }
+  void release() {
+    for (Cell<Dim>* b : blocks_) {
+      if (b) munmap(b, block_bytes);
+    }
+    blocks_.clear();
+  }
+
+  std::vector<Cell<Dim>*> blocks_;
+  std::size_t fill_ = per_block;  // leaves in the last block
+  std::size_t size_ = 0;
+};
+
+/// Appends leaves to one spool and reports to the budget every few thousand leaves, so that
+/// memory stays bounded by max_leaves plus one batch per thread.
 template <int Dim> class Emitter {
  public:
-  Emitter(std::vector<Cell<Dim>>& out, Budget& budget) : out_(out), budget_(budget) {}
+  Emitter(LeafSpool<Dim>& out, Budget& budget) : out_(out), budget_(budget) {}
 
   void emit(const Cell<Dim>& c) {
-    out_.push_back(c);
+    out_.push(c);
     volume_ += volume_units(c);
     if (++pending_ == batch) flush();
   }
@@ -66,7 +127,7 @@ template <int Dim> class Emitter {
 
  private:
   static constexpr std::size_t batch = 4096;
-  std::vector<Cell<Dim>>& out_;
+  LeafSpool<Dim>& out_;
   Budget& budget_;
   std::size_t pending_ = 0;
   std::uint64_t volume_ = 0;
@@ -129,73 +190,80 @@ template <int Dim> struct PredicateRule {
   }
 };
 
-/// Expands `items` in order with `rule` on n_threads threads; the result does not depend on the
-/// thread count because each contiguous chunk writes its own vector and chunks are concatenated.
+/// Runs work(k, emitter) for k = 0..n_work-1 in order on n_threads threads and returns the
+/// leaves in that order. The result does not depend on the thread count: each contiguous chunk
+/// of work items writes its own spool and the spools are concatenated in chunk order.
+template <int Dim, class Work>
+std::vector<Cell<Dim>> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
+  const auto process = [&](std::size_t begin, std::size_t end, LeafSpool<Dim>& out) {
+    Emitter<Dim> e(out, budget);
+    for (std::size_t k = begin; k < end; ++k) work(k, e);
+    e.flush();
+  };
+  // Many more chunks than threads, taken dynamically: refinement is concentrated near the
+  // boundary, so equal item counts are far from equal work.
+  const std::size_t n_chunks = n_threads <= 1 ? std::min<std::size_t>(n_work, 1)
+                                              : std::min(n_work, std::size_t(n_threads) * 16);
+  std::vector<LeafSpool<Dim>> spools(n_chunks);
+  if (n_chunks == 1) {
+    process(0, n_work, spools[0]);
+  } else if (n_chunks > 1) {
+    std::vector<std::exception_ptr> errors(n_chunks);
+    std::atomic<std::size_t> next{0};
+    const auto worker = [&] {
+      for (;;) {
+        const std::size_t k = next.fetch_add(1);
+        if (k >= n_chunks || budget.stop) return;
+        try {
+          process(n_work * k / n_chunks, n_work * (k + 1) / n_chunks, spools[k]);
+        } catch (...) {
+          errors[k] = std::current_exception();
+          budget.stop = true;
+        }
+      }
+    };
+    std::vector<std::thread> threads;
+    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
+    worker();
+    for (auto& th : threads) th.join();
+    // The first refusal that exceeded the budget carries the estimate; prefer it over the
+    // "stopped" notes of the other chunks.
+    std::exception_ptr first;
+    for (const auto& err : errors) {
+      if (!err) continue;
+      try {
+        std::rethrow_exception(err);
+      } catch (const LimitError& le) {
+        if (std::string(le.what()).rfind("refinement would", 0) == 0) throw;
+        if (!first) first = err;
+      } catch (...) {
+        throw;
+      }
+    }
+    if (first) std::rethrow_exception(first);
+  }
+  std::size_t total = 0;
+  for (const auto& s : spools) total += s.size();
+  std::vector<Cell<Dim>> out;
+  out.reserve(total);  // exact: pages are touched only as the spools drain into it
+  for (auto& s : spools) s.drain_into(out);
+  return out;
+}
+
+/// Expands `items` in order with `rule`.
 template <int Dim, class Rule>
 std::vector<Cell<Dim>> expand_items(const std::vector<Item<Dim>>& items, const Rule& rule,
                                     Budget& budget, int n_threads) {
-  const auto process = [&](std::size_t begin, std::size_t end, std::vector<Cell<Dim>>& out) {
-    Emitter<Dim> e(out, budget);
-    for (std::size_t k = begin; k < end; ++k) {
-      if (items[k].expand) {
-        rule.run(items[k].cell, e);
-      } else {
-        e.emit(items[k].cell);
-      }
-    }
-    e.flush();
-  };
-  if (n_threads <= 1 || items.size() <= 1) {
-    std::vector<Cell<Dim>> out;
-    process(0, items.size(), out);
-    return out;
-  }
-  // Many more chunks than threads, taken dynamically: refinement is concentrated near the
-  // boundary, so equal item counts are far from equal work.
-  const std::size_t n_chunks = std::min(items.size(), std::size_t(n_threads) * 16);
-  std::vector<std::vector<Cell<Dim>>> outs(n_chunks);
-  std::vector<std::exception_ptr> errors(n_chunks);
-  std::atomic<std::size_t> next{0};
-  const auto worker = [&] {
-    for (;;) {
-      const std::size_t k = next.fetch_add(1);
-      if (k >= n_chunks || budget.stop) return;
-      try {
-        process(items.size() * k / n_chunks, items.size() * (k + 1) / n_chunks, outs[k]);
-      } catch (...) {
-        errors[k] = std::current_exception();
-        budget.stop = true;
-      }
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-  worker();
-  for (auto& th : threads) th.join();
-  // The first refusal that exceeded the budget carries the estimate; prefer it over the
-  // "stopped" notes of the other chunks.
-  std::exception_ptr first;
-  for (const auto& err : errors) {
-    if (!err) continue;
-    try {
-      std::rethrow_exception(err);
-    } catch (const LimitError& le) {
-      if (std::string(le.what()).rfind("refinement would", 0) == 0) throw;
-      if (!first) first = err;
-    } catch (...) {
-      throw;
-    }
-  }
-  if (first) std::rethrow_exception(first);
-  std::size_t total = 0;
-  for (const auto& o : outs) total += o.size();
-  std::vector<Cell<Dim>> out;
-  out.reserve(total);
-  for (auto& o : outs) {
-    out.insert(out.end(), o.begin(), o.end());
-    std::vector<Cell<Dim>>().swap(o);
-  }
-  return out;
+  return expand_in_order<Dim>(
+      items.size(),
+      [&](std::size_t k, Emitter<Dim>& e) {
+        if (items[k].expand) {
+          rule.run(items[k].cell, e);
+        } else {
+          e.emit(items[k].cell);
+        }
+      },
+      budget, n_threads);
 }
 
 template <int Dim> int level_cap(const RefineOptions& opt) {
@@ -283,10 +351,12 @@ Orthtree<Dim> refine_while(const Orthtree<Dim>& t, const std::function<bool(cons
   const PredicateRule<Dim> rule{pred, level_cap<Dim>(opt)};
   Budget budget;
   init_budget<Dim>(budget, opt);
-  std::vector<Item<Dim>> items;
-  items.reserve(t.n_leaves());
-  for (const auto& c : t.leaves()) items.push_back({c, true});
-  return Orthtree<Dim>(t.root_box(), expand_items(items, rule, budget, opt.n_threads));
+  // Every input leaf is a subtree root to expand: index the leaves directly (no item copies).
+  const auto& leaves = t.leaves();
+  return Orthtree<Dim>(t.root_box(),
+                       expand_in_order<Dim>(
+                           leaves.size(), [&](std::size_t k, Emitter<Dim>& e) { rule.run(leaves[k], e); },
+                           budget, opt.n_threads));
 }
 
 #define FEBEMESH_INSTANTIATE_REFINE(D)                                                              \

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include "core/cell_arbitrary.hpp"
+#include "core/error.hpp"
 #include "core/orthtree.hpp"
 #include "property.hpp"
 
@@ -145,4 +146,34 @@ TEMPLATE_TEST_CASE_SIG("balance properties on random trees", "[orthtree][balance
       if (kind == BalanceKind::Full) RC_ASSERT(is_balanced(b, BalanceKind::Face));
     }
   });
+}
+
+TEMPLATE_TEST_CASE_SIG("balance refuses results beyond the leaf limit", "[orthtree][balance][limits]", ((int Dim), Dim), 2, 3) {
+  // A chain of cells down to level 10 around a point off the coarse lattice: its neighbours
+  // across the parents' facets are coarser, so the balance adds leaves at every level.
+  RefineOptions ro;
+  ro.max_level = 10;
+  LatticePoint<Dim> p;
+  p.fill(root_length<Dim> / 3);
+  const auto t = refine_while<Dim>(Orthtree<Dim>(), [p](const Cell<Dim>& c) { return touches(c, p); }, ro);
+  const auto full = balance_2to1(t);
+  REQUIRE(full.n_leaves() > t.n_leaves());
+  // Exactly the size of the result passes; one less is refused, naming the count and memory.
+  BalanceOptions opt;
+  opt.max_leaves = full.n_leaves();
+  REQUIRE(balance_2to1(t, BalanceKind::Face, opt).leaves() == full.leaves());
+  opt.max_leaves = full.n_leaves() - 1;
+  try {
+    (void)balance_2to1(t, BalanceKind::Face, opt);
+    FAIL("expected LimitError");
+  } catch (const LimitError& e) {
+    const std::string msg = e.what();
+    INFO(msg);
+    REQUIRE(msg.find("max_leaves = " + std::to_string(opt.max_leaves)) != std::string::npos);
+    REQUIRE(msg.find("MiB") != std::string::npos);
+    REQUIRE(msg.find(std::to_string(full.n_leaves())) != std::string::npos);
+  }
+  // An input already beyond the limit is refused before any work.
+  opt.max_leaves = t.n_leaves() - 1;
+  REQUIRE_THROWS_AS(balance_2to1(t, BalanceKind::Full, opt), LimitError);
 }

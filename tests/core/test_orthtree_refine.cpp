@@ -142,6 +142,30 @@ TEMPLATE_TEST_CASE_SIG("mark, refine and refine_while", "[orthtree][refine]", ((
   REQUIRE_THROWS_AS(refine_while<Dim>(root, [](const Cell<Dim>&) { return true; }, opt), LimitError);
 }
 
+TEMPLATE_TEST_CASE_SIG("large refinements span many storage blocks, threads agree", "[orthtree][refine]", ((int Dim), Dim), 2, 3) {
+  // Uniform level 8 (2D, 65536 leaves) or 6 (3D, 262144 leaves): several of the spool's blocks
+  // per thread, drained in order into the tree.
+  constexpr int level = Dim == 2 ? 8 : 6;
+  const Box<Dim> unit{Point<Dim>::Zero(), Point<Dim>::Ones()};
+  const auto control = [](const Box<Dim>&) { return double(level); };
+  RefineOptions opt;
+  const auto serial = subdivide_by_control<Dim>(unit, control, opt);
+  REQUIRE(serial.n_leaves() == std::size_t(1) << (Dim * level));
+  REQUIRE(is_complete(serial));
+  REQUIRE(serial.leaves().capacity() == serial.n_leaves());
+  for (std::size_t i = 0; i < serial.n_leaves(); ++i) {
+    if (serial.leaf(i) != cell_from_key<Dim>(std::uint64_t(i) << (Dim * (max_level<Dim> - level)), level)) {
+      FAIL("leaf " << i << " is not the i-th cell of the uniform grid");
+    }
+  }
+  for (const int threads : {2, 3}) {
+    opt.n_threads = threads;
+    REQUIRE(subdivide_by_control<Dim>(unit, control, opt).leaves() == serial.leaves());
+    REQUIRE(refine_while<Dim>(Orthtree<Dim>(), [](const Cell<Dim>& c) { return c.level < level; }, opt).leaves() ==
+            serial.leaves());
+  }
+}
+
 TEMPLATE_TEST_CASE_SIG("parallel refinement equals serial", "[orthtree][refine][property]", ((int Dim), Dim), 2, 3) {
   test::prop("subdivide_by_control with 1, 2 and 3 threads", 30, [] {
     // A ball-shaped control: level k near a sphere of random radius, lower elsewhere.
