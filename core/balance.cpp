@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
@@ -81,11 +82,16 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
 
   // internal[L]: sorted Morton keys of internal cells at level L. Parents of the leaves come out
   // sorted from the Morton-ordered leaves (masking low bits is monotone).
+  // Each level gets the capacity of an upper bound (its leaves' count); pages of a large
+  // reservation are not touched, so an unused bound costs address space, not memory.
+  std::vector<std::size_t> leaves_at(std::size_t(deepest) + 1, 0);
+  for (const auto& c : leaves) ++leaves_at[c.level];
   std::vector<std::vector<std::uint64_t>> internal(deepest);
+  for (int pl = 0; pl < deepest; ++pl) internal[pl].reserve(leaves_at[pl + 1]);
   for (const auto& c : leaves) {
     if (c.level == 0) continue;
     const int pl = c.level - 1;
-    const std::uint64_t pk = morton_key(c) & ~(volume_units(Cell<Dim>{{}, std::uint8_t(pl)}) - 1);
+    const std::uint64_t pk = detail::interleave<Dim>(c.anchor) & ~((std::uint64_t(1) << (Dim * (max_level<Dim> - pl))) - 1);
     auto& v = internal[pl];
     if (v.empty() || v.back() != pk) v.push_back(pk);
   }
@@ -177,6 +183,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   // each level's internal cells in increasing key order, so one cursor per level suffices.
   std::vector<Cell<Dim>> out;
   out.reserve(1 + n_internal * (nc - 1));  // exact
+  advise_huge_pages(out.data(), out.capacity() * sizeof(Cell<Dim>));
   std::vector<std::size_t> cursor(masks.size() + 1, 0);
   struct Walker {
     const std::vector<std::vector<std::uint8_t>>& masks;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <new>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include <sys/mman.h>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
@@ -45,20 +47,20 @@ struct Budget {
 
 /// Append-only storage of emitted leaves in blocks mapped straight from the kernel. A growing
 /// std::vector would hold its old and new buffers at once (up to 2x the leaves at the last
-/// doubling, 3x while copying), and blocks from malloc may stay resident after free (glibc raises
-/// its mmap threshold once a large block is freed, and the next blocks then come from an arena
-/// that is not trimmed). Own mappings are released the moment they are unmapped, so draining the
-/// spool into an exactly reserved vector keeps the peak at the leaves plus one block.
+/// doubling), and blocks from malloc may stay resident after free (glibc raises its mmap
+/// threshold once a large block is freed, and the next blocks then come from an arena that is
+/// not trimmed). Own mappings are released the moment they are unmapped, so draining the spool
+/// front to back into an exactly reserved vector keeps the peak at the leaves plus one block.
 template <int Dim> class LeafSpool {
  public:
   LeafSpool() = default;
   LeafSpool(const LeafSpool&) = delete;
   LeafSpool& operator=(const LeafSpool&) = delete;
-  LeafSpool(LeafSpool&& o) noexcept : blocks_(std::move(o.blocks_)), fill_(o.fill_), size_(o.size_) {
-    o.blocks_.clear();
-    o.size_ = 0;
+  ~LeafSpool() {
+    for (Cell<Dim>* b : blocks_) {
+      if (b) munmap(b, block_bytes);
+    }
   }
-  ~LeafSpool() { release(); }
 
   void push(const Cell<Dim>& c) {
     if (fill_ == per_block) grow();
@@ -67,34 +69,37 @@ template <int Dim> class LeafSpool {
     ++size_;
   }
   std::size_t size() const { return size_; }
-  /// Appends the leaves to `out` in order, unmapping each block once it is copied.
-  void drain_into(std::vector<Cell<Dim>>& out) {
-    for (std::size_t b = 0; b < blocks_.size(); ++b) {
-      const std::size_t n = b + 1 == blocks_.size() ? fill_ : per_block;
-      out.insert(out.end(), blocks_[b], blocks_[b] + n);
-      munmap(blocks_[b], block_bytes);
-      blocks_[b] = nullptr;
+  /// Appends leaves [begin, end) to `out`. Ranges must be drained in increasing order: blocks
+  /// wholly before `end` are unmapped.
+  void drain(std::size_t begin, std::size_t end, std::vector<Cell<Dim>>& out) {
+    while (begin < end) {
+      const std::size_t b = begin / per_block, stop = std::min(end, (b + 1) * per_block);
+      out.insert(out.end(), blocks_[b] + (begin - b * per_block), blocks_[b] + (stop - b * per_block));
+      if (stop == (b + 1) * per_block) {
+        munmap(blocks_[b], block_bytes);
+        blocks_[b] = nullptr;
+      }
+      begin = stop;
     }
-    blocks_.clear();
-    fill_ = per_block;
-    size_ = 0;
   }
 
  private:
-  static constexpr std::size_t block_bytes = std::size_t(1) << 20;
+  static constexpr std::size_t block_bytes = std::size_t(1) << 21;  // one huge page
   static constexpr std::size_t per_block = block_bytes / sizeof(Cell<Dim>);
 
   void grow() {
-    void* p = mmap(nullptr, block_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (p == MAP_FAILED) throw std::bad_alloc();
-    blocks_.push_back(static_cast<Cell<Dim>*>(p));
+    // Map twice the size and trim to a 2 MiB-aligned block, so that it can be one huge page.
+    constexpr int prot = PROT_READ | PROT_WRITE, flags = MAP_PRIVATE | MAP_ANONYMOUS;
+    void* raw = mmap(nullptr, 2 * block_bytes, prot, flags, -1, 0);
+    if (raw == MAP_FAILED) throw std::bad_alloc();
+    const std::uintptr_t r = reinterpret_cast<std::uintptr_t>(raw);
+    const std::uintptr_t a = (r + block_bytes - 1) & ~std::uintptr_t(block_bytes - 1);
+    if (a > r) munmap(raw, a - r);
+    if (a + block_bytes < r + 2 * block_bytes) munmap(reinterpret_cast<void*>(a + block_bytes), r + block_bytes - a);
+    auto* block = reinterpret_cast<Cell<Dim>*>(a);
+    advise_huge_pages(block, block_bytes);
+    blocks_.push_back(block);
     fill_ = 0;
-  }
-  void release() {
-    for (Cell<Dim>* b : blocks_) {
-      if (b) munmap(b, block_bytes);
-    }
-    blocks_.clear();
   }
 
   std::vector<Cell<Dim>*> blocks_;
@@ -191,31 +196,42 @@ template <int Dim> struct PredicateRule {
 };
 
 /// Runs work(k, emitter) for k = 0..n_work-1 in order on n_threads threads and returns the
-/// leaves in that order. The result does not depend on the thread count: each contiguous chunk
-/// of work items writes its own spool and the spools are concatenated in chunk order.
+/// leaves in that order. The result does not depend on the thread count: the work is cut into
+/// contiguous chunks, each chunk's leaves form one range of its thread's spool, and the ranges
+/// are concatenated in chunk order. Threads take chunks in increasing order, so each spool is
+/// drained front to back and frees its blocks as it goes.
 template <int Dim, class Work>
 std::vector<Cell<Dim>> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
-  const auto process = [&](std::size_t begin, std::size_t end, LeafSpool<Dim>& out) {
+  const int n_spools = std::max(1, n_threads);
+  std::vector<LeafSpool<Dim>> spools(static_cast<std::size_t>(n_spools));
+  struct Range {
+    int spool = 0;
+    std::size_t begin = 0, end = 0;
+  };
+  const auto process = [&](std::size_t begin, std::size_t end, int spool, Range& range) {
+    LeafSpool<Dim>& out = spools[std::size_t(spool)];
+    range = {spool, out.size(), 0};
     Emitter<Dim> e(out, budget);
     for (std::size_t k = begin; k < end; ++k) work(k, e);
     e.flush();
+    range.end = out.size();
   };
   // Many more chunks than threads, taken dynamically: refinement is concentrated near the
   // boundary, so equal item counts are far from equal work.
   const std::size_t n_chunks = n_threads <= 1 ? std::min<std::size_t>(n_work, 1)
                                               : std::min(n_work, std::size_t(n_threads) * 16);
-  std::vector<LeafSpool<Dim>> spools(n_chunks);
+  std::vector<Range> ranges(n_chunks);
   if (n_chunks == 1) {
-    process(0, n_work, spools[0]);
+    process(0, n_work, 0, ranges[0]);
   } else if (n_chunks > 1) {
     std::vector<std::exception_ptr> errors(n_chunks);
     std::atomic<std::size_t> next{0};
-    const auto worker = [&] {
+    const auto worker = [&](int spool) {
       for (;;) {
         const std::size_t k = next.fetch_add(1);
         if (k >= n_chunks || budget.stop) return;
         try {
-          process(n_work * k / n_chunks, n_work * (k + 1) / n_chunks, spools[k]);
+          process(n_work * k / n_chunks, n_work * (k + 1) / n_chunks, spool, ranges[k]);
         } catch (...) {
           errors[k] = std::current_exception();
           budget.stop = true;
@@ -223,8 +239,8 @@ std::vector<Cell<Dim>> expand_in_order(std::size_t n_work, const Work& work, Bud
       }
     };
     std::vector<std::thread> threads;
-    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker);
-    worker();
+    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker, t);
+    worker(0);
     for (auto& th : threads) th.join();
     // The first refusal that exceeded the budget carries the estimate; prefer it over the
     // "stopped" notes of the other chunks.
@@ -246,7 +262,8 @@ std::vector<Cell<Dim>> expand_in_order(std::size_t n_work, const Work& work, Bud
   for (const auto& s : spools) total += s.size();
   std::vector<Cell<Dim>> out;
   out.reserve(total);  // exact: pages are touched only as the spools drain into it
-  for (auto& s : spools) s.drain_into(out);
+  advise_huge_pages(out.data(), total * sizeof(Cell<Dim>));
+  for (const Range& r : ranges) spools[std::size_t(r.spool)].drain(r.begin, r.end, out);
   return out;
 }
 
@@ -335,6 +352,7 @@ template <int Dim> Orthtree<Dim> refine(const Orthtree<Dim>& t, const Flags& fla
   }
   std::vector<Cell<Dim>> out;
   out.reserve(t.n_leaves() + n_flagged * (Cube<Dim>::n_children - 1));
+  advise_huge_pages(out.data(), out.capacity() * sizeof(Cell<Dim>));
   for (std::size_t i = 0; i < flags.size(); ++i) {
     if (flags[i]) {
       for (int k = 0; k < Cube<Dim>::n_children; ++k) out.push_back(make_child(t.leaf(i), k));
