@@ -21,13 +21,17 @@ using namespace febemesh::dim2;
 
 const char* const help = R"(usage: febemesh compare2d INPUT -o DIR [options]
 
-Meshes INPUT with febemesh (mesh2d, triangles) and with Gmsh (`gmsh -2` on a .geo holding the
-exact cubic Bezier pieces of every loop), choosing Gmsh's mesh size so that its triangle count is
-within the tolerance of ours, and measures both meshes with the same code.
+Meshes INPUT with febemesh (mesh2d) and with Gmsh (`gmsh -2` on a .geo holding the exact cubic
+Bezier pieces of every loop), both with the same element kind, choosing Gmsh's mesh size so that
+its element count is within the tolerance of ours, and measures both meshes with the same code.
 
 options:
   -o, --output DIR   output folder (written atomically; replaced if it exists)
   --level N          febemesh's level at the curve (default: the file's levels, else automatic)
+  --elements KIND    tri (default) | quad | mixed. Gmsh: tri = its default triangles; mixed =
+                     Mesh.RecombineAll with Blossom (quad-dominant; it may pair all); quad =
+                     the same plus Mesh.SubdivisionAlgorithm 1 (all quads, one split more, as
+                     febemesh's quad mode splits its mixed mesh once more)
   --gmsh PROGRAM     the Gmsh program (default: gmsh)
   --tolerance F      accepted relative difference of the element counts (default 0.2)
   --iterations N     at most N Gmsh runs to match the count (default 6)
@@ -35,7 +39,7 @@ options:
 
 outputs in DIR: mesh.msh (ours), gmsh.geo, gmsh.msh, gmsh.log, comparison.json ({"febemesh": {..},
 "gmsh": {..}}: elements, nodes, wall_seconds, elements_per_second, min_angle_deg, max_angle_deg,
-area_rel_error, hausdorff_rel, ...), comparison.md, min-angle.svg, scaled-jacobian.svg.
+area_rel_error, hausdorff_rel, ...), comparison.md, min-angle.svg (0-60 deg for tri, 0-90 for quad/mixed), scaled-jacobian.svg.
 Both tools run single-threaded; our wall time is mesh2d + writing mesh.msh, Gmsh's is its whole
 run as a subprocess. A tool that fails is reported with "ok": false and its message verbatim.
 exit status: 0 both tools meshed, 1 bad input or a tool failed, 2 bad usage.
@@ -48,6 +52,7 @@ nlohmann::ordered_json metrics_json(const MeshMetrics2d& m) {
   j["settings"] = m.settings;
   if (m.ok) {
     j["elements"] = m.elements;
+    j["quads"] = m.quads;
     j["nodes"] = m.nodes;
     j["boundary_edges"] = m.boundary_edges;
     j["wall_seconds"] = m.wall_seconds;
@@ -65,13 +70,14 @@ nlohmann::ordered_json metrics_json(const MeshMetrics2d& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--gmsh", "--tolerance", "--iterations"});
+  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--elements", "--gmsh", "--tolerance", "--iterations"});
   args.expect_positional({"INPUT"});
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
   if (out.empty()) throw UsageError("missing -o DIR");
   Options2d opt;
   opt.level = args.real_or("--level", no_level, 0, 20);
+  opt.elements = element_kind_from(args.choice_or("--elements", "tri", {"tri", "quad", "mixed"}));
   opt.keep_stages = false;
   opt.n_threads = 1;
   CompareOptions2d copt;
@@ -98,35 +104,26 @@ int run(const std::vector<std::string>& argv) {
   j["gmsh"]["size_trials"] = trials;
   if (c.febemesh.ok && c.gmsh.ok)
     j["element_count_ratio"] = double(c.gmsh.elements) / double(c.febemesh.elements);
-  write_text(dir.file("comparison.json"), j.dump(2) + "\n");
-  write_text(dir.file("comparison.md"),
-             comparison_markdown("febemesh vs Gmsh: " + input, j, {"febemesh", "gmsh"},
-                                 {"elements", "nodes", "boundary_edges", "wall_seconds", "elements_per_second",
-                                  "min_angle_deg", "max_angle_deg", "elements_below_30deg", "min_scaled_jacobian",
-                                  "mean_scaled_jacobian", "area_rel_error", "hausdorff_rel", "node_distance_rel"}));
-  Series angles, jac;
-  for (const auto* m : {&c.febemesh, &c.gmsh}) {
-    const std::string name = m == &c.febemesh ? "febemesh" : "gmsh";
+  ComparisonOutput report;
+  report.command = "compare2d";
+  report.title = "febemesh vs Gmsh (" + std::string(name(opt.elements)) + "): " + input;
+  report.json = std::move(j);
+  report.tools = {"febemesh", "gmsh"};
+  report.keys = {"elements", "quads", "nodes", "boundary_edges", "wall_seconds", "elements_per_second", "min_angle_deg",
+                 "max_angle_deg", "elements_below_30deg", "min_scaled_jacobian", "mean_scaled_jacobian",
+                 "area_rel_error", "hausdorff_rel", "node_distance_rel"};
+  report.quality_key = "min_angle_deg";
+  // Quads have right angles where triangles have 60 degrees.
+  const double best_angle = opt.elements == ElementKind::Tri ? 60.0 : 90.0;
+  HistogramPlot angles{"min-angle.svg", "Smallest angle per element", "degrees", 0.0, best_angle, 30, {}};
+  HistogramPlot jac{"scaled-jacobian.svg", "Scaled Jacobian per element", "scaled Jacobian", 0.0, 1.0, 25, {}};
+  for (const auto& [tool, m] : {std::pair{"febemesh", &c.febemesh}, std::pair{"gmsh", &c.gmsh}}) {
     if (!m->ok) continue;
-    angles.emplace_back(name, m->element_min_angle_deg);
-    jac.emplace_back(name, m->element_scaled_jacobian);
+    angles.series.emplace_back(tool, m->element_min_angle_deg);
+    jac.series.emplace_back(tool, m->element_scaled_jacobian);
   }
-  write_histogram_svg(dir.file("min-angle.svg"), "Smallest angle per element", "degrees", 0.0, 60.0, 30, angles);
-  write_histogram_svg(dir.file("scaled-jacobian.svg"), "Scaled Jacobian per element", "scaled Jacobian", 0.0, 1.0,
-                      25, jac);
-  dir.commit();
-  if (!quiet) {
-    for (const auto* m : {&c.febemesh, &c.gmsh}) {
-      const std::string name = m == &c.febemesh ? "febemesh" : "gmsh";
-      if (m->ok)
-        std::cerr << "compare2d: " << name << ": " << m->elements << " elements, min angle " << m->min_angle_deg
-                  << " deg, " << m->elements_per_second << " elements/s\n";
-      else
-        std::cerr << "compare2d: " << name << " failed: " << m->error << "\n";
-    }
-  }
-  std::cout << out << "\n";
-  return c.febemesh.ok && c.gmsh.ok ? exit_ok : exit_bad_input;
+  report.plots = {std::move(angles), std::move(jac)};
+  return finish_comparison(dir, report, quiet);
 }
 
 }  // namespace

@@ -92,43 +92,30 @@ int run(const std::vector<std::string>& argv) {
   for (const auto& [v, n] : c.tetgen_trials) trials.push_back({{"volume_bound", v}, {"elements", n}});
   j["tetgen"]["volume_bound_trials"] = trials;
   if (c.febemesh.ok && c.tetgen.ok) j["element_count_ratio"] = double(c.tetgen.elements) / double(c.febemesh.elements);
-  write_text(dir.file("comparison.json"), j.dump(2) + "\n");
-  write_text(dir.file("comparison.md"),
-             comparison_markdown("febemesh vs TetGen: " + input, j, {"febemesh", "tetgen"},
-                                 {"elements", "nodes", "boundary_triangles", "wall_seconds", "elements_per_second",
-                                  "peak_memory_bytes", "min_dihedral_deg", "max_dihedral_deg",
-                                  "slivers_below_10deg", "min_scaled_jacobian", "mean_scaled_jacobian",
-                                  "max_radius_ratio", "volume_rel_error", "hausdorff_rel"}));
-  Series mind, maxd, rr, sj;
-  for (const auto* m : {&c.febemesh, &c.tetgen}) {
+  ComparisonOutput report;
+  report.command = "compare3d";
+  report.title = "febemesh vs TetGen: " + input;
+  report.json = std::move(j);
+  report.tools = {"febemesh", "tetgen"};
+  report.keys = {"elements", "nodes", "boundary_triangles", "wall_seconds", "elements_per_second",
+                 "peak_memory_bytes", "min_dihedral_deg", "max_dihedral_deg", "slivers_below_10deg",
+                 "min_scaled_jacobian", "mean_scaled_jacobian", "max_radius_ratio", "volume_rel_error",
+                 "hausdorff_rel"};
+  report.unit = "tets";
+  report.quality_key = "min_dihedral_deg";
+  HistogramPlot mind{"min-dihedral.svg", "Smallest dihedral angle per tetrahedron", "degrees", 0.0, 90.0, 30, {}};
+  HistogramPlot maxd{"max-dihedral.svg", "Largest dihedral angle per tetrahedron", "degrees", 60.0, 180.0, 30, {}};
+  HistogramPlot rr{"radius-ratio.svg", "Radius ratio R/(3r) per tetrahedron (1 = regular)", "R / 3r", 1.0, 5.0, 32, {}};
+  HistogramPlot sj{"scaled-jacobian.svg", "Scaled Jacobian per tetrahedron", "scaled Jacobian", 0.0, 1.0, 25, {}};
+  for (const auto& [tool, m] : {std::pair{"febemesh", &c.febemesh}, std::pair{"tetgen", &c.tetgen}}) {
     if (!m->ok) continue;
-    const std::string name = m == &c.febemesh ? "febemesh" : "tetgen";
-    mind.emplace_back(name, m->element_min_dihedral_deg);
-    maxd.emplace_back(name, m->element_max_dihedral_deg);
-    rr.emplace_back(name, m->element_radius_ratio);
-    sj.emplace_back(name, m->element_scaled_jacobian);
+    mind.series.emplace_back(tool, m->element_min_dihedral_deg);
+    maxd.series.emplace_back(tool, m->element_max_dihedral_deg);
+    rr.series.emplace_back(tool, m->element_radius_ratio);
+    sj.series.emplace_back(tool, m->element_scaled_jacobian);
   }
-  write_histogram_svg(dir.file("min-dihedral.svg"), "Smallest dihedral angle per tetrahedron", "degrees", 0.0, 90.0,
-                      30, mind);
-  write_histogram_svg(dir.file("max-dihedral.svg"), "Largest dihedral angle per tetrahedron", "degrees", 60.0, 180.0,
-                      30, maxd);
-  write_histogram_svg(dir.file("radius-ratio.svg"), "Radius ratio R/(3r) per tetrahedron (1 = regular)", "R / 3r", 1.0,
-                      5.0, 32, rr);
-  write_histogram_svg(dir.file("scaled-jacobian.svg"), "Scaled Jacobian per tetrahedron", "scaled Jacobian", 0.0, 1.0,
-                      25, sj);
-  dir.commit();
-  if (!quiet) {
-    for (const auto* m : {&c.febemesh, &c.tetgen}) {
-      const std::string name = m == &c.febemesh ? "febemesh" : "tetgen";
-      if (m->ok)
-        std::cerr << "compare3d: " << name << ": " << m->elements << " tets, min dihedral " << m->min_dihedral_deg
-                  << " deg, " << m->elements_per_second << " tets/s\n";
-      else
-        std::cerr << "compare3d: " << name << " failed: " << m->error << "\n";
-    }
-  }
-  std::cout << out << "\n";
-  return c.febemesh.ok && c.tetgen.ok ? exit_ok : exit_bad_input;
+  report.plots = {std::move(mind), std::move(maxd), std::move(rr), std::move(sj)};
+  return finish_comparison(dir, report, quiet);
 }
 
 }  // namespace

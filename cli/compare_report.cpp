@@ -6,6 +6,9 @@
 #include <fstream>
 #include <sstream>
 
+#include <iostream>
+
+#include "cli/command.hpp"
 #include "core/error.hpp"
 #include "core/svg_canvas.hpp"
 
@@ -111,6 +114,29 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream os(path);
   os << text;
   if (!os) throw InputError(path.string() + ": cannot write");
+}
+
+int finish_comparison(AtomicOutputDir& dir, const ComparisonOutput& out, bool quiet) {
+  write_text(dir.file("comparison.json"), out.json.dump(2) + "\n");
+  write_text(dir.file("comparison.md"), comparison_markdown(out.title, out.json, out.tools, out.keys));
+  for (const HistogramPlot& p : out.plots)
+    write_histogram_svg(dir.file(p.file), p.title, p.x_label, p.lo, p.hi, p.n_bins, p.series);
+  dir.commit();
+  bool all_ok = true;
+  for (const std::string& tool : out.tools) {
+    const auto& t = out.json.at(tool);
+    const bool ok = t.value("ok", false);
+    all_ok = all_ok && ok;
+    if (quiet) continue;
+    if (ok)
+      std::cerr << out.command << ": " << tool << ": " << t.value("elements", std::size_t(0)) << " " << out.unit << ", "
+                << out.quality_key << " " << t.value(out.quality_key, 0.0) << ", "
+                << t.value("elements_per_second", 0.0) << " " << out.unit << "/s\n";
+    else
+      std::cerr << out.command << ": " << tool << " failed: " << t.value("error", std::string()) << "\n";
+  }
+  std::cout << dir.final_path().string() << "\n";
+  return all_ok ? exit_ok : exit_bad_input;
 }
 
 }  // namespace febemesh::cli

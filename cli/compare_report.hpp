@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/atomic_output.hpp"
+
 namespace febemesh::cli {
 
 /// One series of values per tool, e.g. {"febemesh", angles}, {"gmsh", angles}.
@@ -26,5 +28,30 @@ std::string comparison_markdown(const std::string& title, const nlohmann::ordere
 
 /// Writes `text` to `path`; InputError when it cannot.
 void write_text(const std::filesystem::path& path, const std::string& text);
+
+/// One histogram plot of a comparison (write_histogram_svg's arguments).
+struct HistogramPlot {
+  std::string file, title, x_label;
+  double lo = 0.0, hi = 1.0;
+  int n_bins = 20;
+  Series series;  ///< one entry per tool that meshed
+};
+
+/// Everything compare2d / compare3d write and print once both tools have run.
+struct ComparisonOutput {
+  std::string command;               ///< "compare2d", for messages
+  std::string title;                 ///< heading of comparison.md
+  nlohmann::ordered_json json;       ///< comparison.json: one object per tool (with "ok", "error")
+  std::vector<std::string> tools;    ///< e.g. {"febemesh", "gmsh"}
+  std::vector<std::string> keys;     ///< rows of comparison.md
+  std::vector<HistogramPlot> plots;
+  std::string unit = "elements";     ///< for the progress lines: "elements", "tets"
+  std::string quality_key;           ///< reported in the progress lines, e.g. "min_angle_deg"
+};
+
+/// Writes comparison.json, comparison.md and the plots into `dir` and commits it; unless
+/// `quiet`, one line per tool on stderr (count, quality, speed, or its failure). Prints the
+/// folder on stdout. Returns exit_ok when every tool meshed, exit_bad_input otherwise.
+int finish_comparison(AtomicOutputDir& dir, const ComparisonOutput& out, bool quiet);
 
 }  // namespace febemesh::cli

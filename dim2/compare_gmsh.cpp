@@ -115,6 +115,23 @@ std::string error_lines(const std::string& log) {
 
 }  // namespace
 
+std::string gmsh_recombination(ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Tri: return "";
+    case ElementKind::Mixed: return "Mesh.RecombineAll = 1;\nMesh.RecombinationAlgorithm = 1;\n";
+    case ElementKind::Quad:
+      return "Mesh.RecombineAll = 1;\nMesh.RecombinationAlgorithm = 1;\nMesh.SubdivisionAlgorithm = 1;\n";
+  }
+  return "";
+}
+
+double initial_gmsh_size(double area, double target, ElementKind kind) {
+  // A uniform size h gives about 4 A / (sqrt(3) h^2) triangles; Blossom recombination pairs most
+  // of them (about half as many elements); the all-quad subdivision splits those into four.
+  const double per_h2 = kind == ElementKind::Tri ? 4.0 / std::sqrt(3.0) : kind == ElementKind::Mixed ? 2.0 / std::sqrt(3.0) : 8.0 / std::sqrt(3.0);
+  return std::sqrt(per_h2 * area / target);
+}
+
 double curve_polyline_hausdorff(const CurveBoundary& curve, const std::vector<Point<2>>& points,
                                 const Elements& edges) {
   if (edges.empty()) return std::numeric_limits<double>::infinity();
@@ -151,6 +168,7 @@ MeshMetrics2d measure_mesh2d(const Mesh<2>& mesh, const CurveBoundary& curve) {
   MeshMetrics2d m;
   m.ok = true;
   m.elements = mesh.solid.size();
+  m.quads = std::size_t(std::count(mesh.solid.type.begin(), mesh.solid.type.end(), ElemType::Quad4));
   m.nodes = mesh.points.size();
   m.boundary_edges = mesh.interface.size();
   const QualitySummary q = summarize_quality<2>(mesh, 30.0);
@@ -179,11 +197,12 @@ MeshMetrics2d measure_mesh2d(const Mesh<2>& mesh, const CurveBoundary& curve) {
   return m;
 }
 
-std::string gmsh_geo(const CurveBoundary& curve, double h) {
+std::string gmsh_geo(const CurveBoundary& curve, double h, ElementKind kind) {
   std::ostringstream os;
   os << "// Written by febemesh compare2d: the exact cubic Bezier pieces of every loop.\n";
   os << "h = " << g17(h) << ";\n";
   os << "Mesh.MeshSizeMax = h;\nMesh.MeshSizeFromCurvature = 0;\n";
+  os << gmsh_recombination(kind);
   int next_point = 1, next_curve = 1;
   std::vector<std::vector<int>> curves_of(std::size_t(curve.n_loops()));
   for (int l = 0; l < curve.n_loops(); ++l) {
@@ -284,7 +303,7 @@ GmshRun run_gmsh(const std::string& gmsh, const std::string& geo, const fs::path
     return r;
   }
   if (r.mesh.solid.empty()) {
-    r.error = "Gmsh wrote no triangles" + (log.empty() ? std::string() : ": " + log);
+    r.error = "Gmsh wrote no surface elements" + (log.empty() ? std::string() : ": " + log);
     return r;
   }
   r.ok = true;
@@ -314,10 +333,10 @@ Comparison2d compare_with_gmsh(const CurveBoundary& curve, const Options2d& opt,
 
   const Box<2> bb = curve.bounding_box();
   const double target = c.febemesh.ok ? double(c.febemesh.elements) : 0.0;
-  double h = target > 0 ? std::sqrt(4.0 * curve.area() / (std::sqrt(3.0) * target)) : (bb.hi - bb.lo).norm() / 50.0;
+  double h = target > 0 ? initial_gmsh_size(curve.area(), target, opt.elements) : (bb.hi - bb.lo).norm() / 50.0;
   GmshRun best;
   for (int it = 0; it < std::max(1, copt.max_iterations); ++it) {
-    GmshRun run = run_gmsh(copt.gmsh, gmsh_geo(curve, h), out, "gmsh");
+    GmshRun run = run_gmsh(copt.gmsh, gmsh_geo(curve, h, opt.elements), out, "gmsh");
     ++c.gmsh_iterations;
     c.gmsh_size = h;
     if (!run.ok) {
@@ -331,8 +350,11 @@ Comparison2d compare_with_gmsh(const CurveBoundary& curve, const Options2d& opt,
     h *= std::sqrt(n / target);
   }
   std::ostringstream gs;
-  gs << "gmsh -2 -nt 1 (Frontal-Delaunay default), uniform size h = " << c.gmsh_size << " after "
-     << c.gmsh_iterations << " run(s)";
+  gs << "gmsh -2 -nt 1 (Frontal-Delaunay default"
+     << (opt.elements == ElementKind::Tri     ? ""
+         : opt.elements == ElementKind::Mixed ? ", RecombineAll with Blossom: quad-dominant"
+                                              : ", RecombineAll with Blossom and SubdivisionAlgorithm 1: all quads")
+     << "), uniform size h = " << c.gmsh_size << " after " << c.gmsh_iterations << " run(s)";
   if (best.ok) {
     c.gmsh = measure_mesh2d(best.mesh, curve);
     c.gmsh.wall_seconds = best.wall_seconds;

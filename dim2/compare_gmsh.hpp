@@ -5,7 +5,7 @@
 // not a polyline), a `Curve Loop` per loop and a `Plane Surface` per outer loop with the holes
 // directly inside it. Its mesh size is chosen so that its triangle count lands within a
 // tolerance of ours (a uniform size h gives about 4 A / (sqrt(3) h^2) triangles; h is rescaled
-// by sqrt(count ratio) a few times). Both meshes are then measured by the same code
+// by sqrt(count ratio) a few times). Quad and mixed meshes use Gmsh's recombination. Both meshes are then measured by the same code
 // (measure_mesh2d): quality from core/quality.hpp, area against CurveBoundary::area(), and a
 // two-sided Hausdorff estimate between the curve and the boundary polyline.
 // Wall times: ours is mesh2d plus writing mesh.msh, in process; Gmsh's is its whole
@@ -28,6 +28,7 @@ struct MeshMetrics2d {
   std::string error;             ///< the tool's failure message, verbatim, when !ok
   std::string settings;          ///< how the tool was run (options, mesh size)
   std::size_t elements = 0;      ///< FE elements (triangles / quads)
+  std::size_t quads = 0;         ///< of which quadrilaterals
   std::size_t nodes = 0;
   std::size_t boundary_edges = 0;
   double wall_seconds = 0.0;
@@ -56,7 +57,17 @@ double curve_polyline_hausdorff(const CurveBoundary& curve, const std::vector<Po
 
 /// Gmsh .geo text of the domain with mesh size `h` everywhere; exact cubic Bezier pieces.
 /// Physical groups "solid" (surfaces) and "interface" (curves), as core/read_msh expects.
-std::string gmsh_geo(const CurveBoundary& curve, double h);
+/// quad / mixed add Gmsh's recombination (gmsh_recombination).
+std::string gmsh_geo(const CurveBoundary& curve, double h, ElementKind kind = ElementKind::Tri);
+
+/// The .geo options that make Gmsh produce our element kind: nothing for tri; mixed:
+/// Mesh.RecombineAll with the Blossom algorithm (quad-dominant, triangles left where pairing
+/// fails); quad: the same, then Mesh.SubdivisionAlgorithm = 1 (every element split into quads,
+/// as our quad mode splits the mixed mesh once more).
+std::string gmsh_recombination(ElementKind kind);
+
+/// Gmsh's uniform mesh size expected to give `target` elements of `kind` on `area`.
+double initial_gmsh_size(double area, double target, ElementKind kind);
 
 struct GmshRun {
   bool ok = false;
@@ -84,8 +95,8 @@ struct Comparison2d {
   std::vector<std::pair<double, std::size_t>> gmsh_trials;  ///< (size, element count) per run
 };
 
-/// Runs mesh2d (our mesh written to out/mesh.msh) and then Gmsh in `out` until the counts
-/// match. Our failure (an exception of mesh2d) is reported in febemesh.error; Gmsh then runs
+/// Runs mesh2d (our mesh written to out/mesh.msh) and then Gmsh in `out`, with the same element
+/// kind (opt.elements), until the counts match. Our failure (an exception of mesh2d) is reported in febemesh.error; Gmsh then runs
 /// once with size = bounding-box diagonal / 50.
 Comparison2d compare_with_gmsh(const CurveBoundary& curve, const Options2d& opt, const CompareOptions2d& copt,
                                const std::filesystem::path& out);

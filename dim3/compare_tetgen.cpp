@@ -230,6 +230,28 @@ ChildResult run_in_child(const std::function<void()>& job) {
   return r;
 }
 
+namespace {
+
+/// A tool's metrics after its run in a child: its .msh read back and measured (so both tools
+/// are measured by the same code), or its error verbatim.
+MeshMetrics3d child_metrics(const ChildResult& run, const fs::path& msh, const SurfaceBoundary& surface,
+                            const std::string& settings) {
+  MeshMetrics3d m;
+  if (run.ok) {
+    m = measure_mesh3d(read_msh<3>(msh), surface);
+    m.wall_seconds = run.wall_seconds;
+    m.elements_per_second = double(m.elements) / run.wall_seconds;
+    m.peak_memory_bytes = run.peak_memory_growth_bytes;
+  } else {
+    m.ok = false;
+    m.error = run.error;
+  }
+  m.settings = settings;
+  return m;
+}
+
+}  // namespace
+
 Comparison3d compare_with_tetgen(const std::string& surface_path, const Options3d& opt,
                                  const CompareOptions3d& copt, const fs::path& out) {
   Comparison3d c;
@@ -246,17 +268,7 @@ Comparison3d compare_with_tetgen(const std::string& surface_path, const Options3
     const Result3d r = mesh3d(s, opt);
     write_msh<3>(r.fe.mesh, ours);
   });
-  if (rf.ok) {
-    const std::string settings = c.febemesh.settings;
-    c.febemesh = measure_mesh3d(read_msh<3>(ours), surface);
-    c.febemesh.settings = settings;
-    c.febemesh.wall_seconds = rf.wall_seconds;
-    c.febemesh.elements_per_second = double(c.febemesh.elements) / rf.wall_seconds;
-    c.febemesh.peak_memory_bytes = rf.peak_memory_growth_bytes;
-  } else {
-    c.febemesh.ok = false;
-    c.febemesh.error = rf.error;
-  }
+  c.febemesh = child_metrics(rf, ours, surface, c.febemesh.settings);
 
   const double target = c.febemesh.ok ? double(c.febemesh.elements) : 0.0;
   // With -q the mean tet volume is well below the bound; start at twice the mean ours has.
@@ -281,19 +293,9 @@ Comparison3d compare_with_tetgen(const std::string& surface_path, const Options3
     if (std::abs(n - target) <= copt.tolerance * target) break;
     bound *= n / target;
   }
-  c.tetgen.settings = "libtet tetrahedralize(\"" + c.tetgen_switches +
-                      "\") in process; timed from reading the file to writing tetgen.msh";
-  if (rt.ok) {
-    const std::string settings = c.tetgen.settings;
-    c.tetgen = measure_mesh3d(read_msh<3>(theirs), surface);
-    c.tetgen.settings = settings;
-    c.tetgen.wall_seconds = rt.wall_seconds;
-    c.tetgen.elements_per_second = double(c.tetgen.elements) / rt.wall_seconds;
-    c.tetgen.peak_memory_bytes = rt.peak_memory_growth_bytes;
-  } else {
-    c.tetgen.ok = false;
-    c.tetgen.error = rt.error;
-  }
+  c.tetgen = child_metrics(rt, theirs, surface,
+                           "libtet tetrahedralize(\"" + c.tetgen_switches +
+                               "\") in process; timed from reading the file to writing tetgen.msh");
   return c;
 }
 

@@ -81,8 +81,44 @@ TEST_CASE("compare2d reports a failing Gmsh and exits with status 1", "[cli][com
   std::filesystem::remove_all(out.parent_path());
 }
 
+TEST_CASE("compare2d --elements quad and mixed use Gmsh's recombination", "[cli][compare]") {
+  if (!have_gmsh()) {
+    WARN("gmsh is not installed: compare2d test skipped");
+    return;
+  }
+  for (const std::string kind : {"quad", "mixed"}) {
+    INFO(kind);
+    const auto out = tmp_dir() / kind;
+    REQUIRE(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json' -o '" +
+                       out.string() + "' --level 4 --quiet --elements " + kind) == 0);
+    std::ifstream in(out / "comparison.json");
+    const auto j = nlohmann::json::parse(in);
+    for (const char* tool : {"febemesh", "gmsh"}) {
+      INFO(tool);
+      REQUIRE(j[tool]["ok"] == true);
+      const auto n = j[tool]["elements"].get<std::size_t>(), quads = j[tool]["quads"].get<std::size_t>();
+      if (kind == "quad")
+        CHECK(quads == n);
+      else
+        CHECK(quads > n / 2);  // quad-dominant (ours keeps triangle fans; Blossom may pair everything)
+      CHECK(j[tool]["min_angle_deg"].get<double>() > 0.0);
+      CHECK(j[tool]["area_rel_error"].get<double>() < 0.02);
+    }
+    const double ours = j["febemesh"]["elements"].get<double>(), gmsh = j["gmsh"]["elements"].get<double>();
+    CHECK(std::abs(gmsh - ours) <= 0.2 * ours);
+    std::ifstream geo(out / "gmsh.geo");
+    std::stringstream ss;
+    ss << geo.rdbuf();
+    CHECK(ss.str().find("Mesh.RecombineAll = 1;") != std::string::npos);
+    CHECK((ss.str().find("Mesh.SubdivisionAlgorithm = 1;") != std::string::npos) == (kind == "quad"));
+  }
+  std::filesystem::remove_all(tmp_dir());
+}
+
 TEST_CASE("compare2d refuses bad usage and bad input", "[cli][compare]") {
   CHECK(run_status("compare2d") == 2);
+  CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
+                   "/examples/flange.json' -o /tmp/febemesh_compare_never --elements hex") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json'") == 2);
   CHECK(run_status("compare2d /nonexistent.json -o /tmp/febemesh_compare_never") == 1);
   CHECK(!std::filesystem::exists("/tmp/febemesh_compare_never"));
