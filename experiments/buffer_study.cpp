@@ -182,7 +182,7 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
     for (const Curve& cv : curves) {
       std::vector<P2> pts;
       for (const auto& [key, s] : sums)
-        if (key.first == qp && s.ok > 0) pts.push_back(top(key.second, s.*cv.field));
+        if (key.first == qp && s.valid > 0) pts.push_back(top(key.second, s.*cv.field));
       svg.polyline(pts, SvgStyle{"none", c, cv.width, 1.0});
       for (const P2& p : pts) svg.dot(p, cv.width + 1.0, SvgStyle{c, "none", 0.0, 1.0});
       svg.text(P2(1.05, 1.0 - 0.07 * (colour * 4 + k)), (qp ? "quality pass: " : "paper only: ") + cv.label, 11.0, c);
@@ -190,14 +190,14 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
     }
     std::vector<P2> pts;
     for (const auto& [key, s] : sums)
-      if (key.first == qp && s.ok > 0) pts.push_back(bottom(key.second, s.elements_ratio));
+      if (key.first == qp && s.valid > 0) pts.push_back(bottom(key.second, s.elements_ratio));
     svg.polyline(pts, SvgStyle{"none", c, 2.0, 1.0});
     for (const P2& p : pts) svg.dot(p, 3.0, SvgStyle{c, "none", 0.0, 1.0});
     svg.text(P2(1.05, -0.35 - 0.07 * colour), (qp ? "quality pass" : "paper only"), 11.0, c);
     ++colour;
   }
-  svg.text(P2(0.0, 1.06), "Buffer fraction F vs smallest angles (degrees, mean over inputs and levels)", 14.0);
-  svg.text(P2(0.0, -0.24), "Element count relative to F = 0 (mean over inputs and levels)", 14.0);
+  svg.text(P2(0.0, 1.06), "Buffer fraction F vs smallest angles (degrees, mean over the inputs and levels meshed at every F)", 14.0);
+  svg.text(P2(0.0, -0.24), "Element count relative to F = 0 (mean over the inputs and levels meshed at every F)", 14.0);
   svg.text(P2(0.75, -1.23), "buffer fraction F", 12.0);
   svg.write(file);
 }
@@ -251,12 +251,22 @@ int main(int argc, char** argv) {
   std::map<std::tuple<std::string, int, bool>, std::size_t> base;
   for (const Run& r : runs)
     if (r.ok && r.fraction == 0.0) base[{r.input, r.level, r.quality_pass}] = r.elements;
+  // Averages compare like with like: only inputs and levels that meshed at every fraction in
+  // both variants enter them (a run that fails at large F would otherwise leave the average).
+  std::map<std::pair<std::string, int>, bool> complete;
+  for (const Run& r : runs) {
+    auto it = complete.emplace(std::pair{r.input, r.level}, true).first;
+    it->second = it->second && r.ok;
+  }
+  std::size_t n_complete = 0;
+  for (const auto& [key, ok] : complete) n_complete += ok;
   std::map<std::pair<bool, double>, Summary> sums;
   for (const Run& r : runs) {
     Summary& s = sums[{r.quality_pass, r.fraction}];
     ++s.runs;
     if (!r.ok) continue;
     ++s.ok;
+    if (!complete[{r.input, r.level}]) continue;
     s.valid += r.valid;
     s.thin += r.n_thin;
     s.min_angle = std::min(s.min_angle, r.min_angle);
@@ -269,8 +279,9 @@ int main(int argc, char** argv) {
     s.elements_ratio += b != base.end() ? double(r.elements) / double(b->second) : 1.0;
   }
   for (auto& [key, s] : sums) {
-    if (s.ok == 0) continue;
-    for (double* v : {&s.mean_min_angle, &s.mean_angle, &s.p5, &s.boundary_min, &s.elements_ratio}) *v /= double(s.ok);
+    if (n_complete == 0) continue;
+    for (double* v : {&s.mean_min_angle, &s.mean_angle, &s.p5, &s.boundary_min, &s.elements_ratio})
+      *v /= double(n_complete);
   }
 
   std::ostringstream md, csv;
@@ -281,7 +292,10 @@ int main(int argc, char** argv) {
   md << ", triangles. *Paper only*: 4 Laplacian passes and nothing else; *quality pass*: febemesh's default edge "
         "flips and angle-guarded smoothing after it. Angles are each element's smallest angle; *thinnest* is the "
         "smallest min(|Q1P1|, |Q2P2|) / |Q1Q2| over boundary quadrants before smoothing; *thin* counts boundary "
-        "quadrants with that ratio below 0.1. Means are over the runs that meshed.\n\n"
+        "quadrants with that ratio below 0.1. *meshed* and *valid* count every run; the other columns "
+        "(and the plot) are over the "
+     << n_complete << " of " << complete.size()
+     << " input-level pairs that meshed at every F in both variants, so each F averages the same meshes.\n\n"
      << "![plot](buffer_study.svg)\n\n"
      << "| variant | F | meshed | valid | min angle | mean of min angle | mean angle | mean 5th pct | mean bq min "
         "angle | thinnest | thin bq | elements / elements(F=0) |\n"

@@ -505,6 +505,11 @@ std::string figures_for(const std::string& input, const fs::path& out, const std
   figures.push_back(control_points_figure(curve, dir, first_number));
   figures.push_back(control_parameter_figure(curve, dir));
   for (const Stage& s : stage_figures) {
+    // figures2d names its files by stage; one it no longer writes is reported, not fatal.
+    if (!fs::exists(stages / s.from)) {
+      figures.push_back({s.number, "-", "missing: dim2/figures2d wrote no " + s.from + ". " + s.caption});
+      continue;
+    }
     fs::rename(stages / s.from, dir / s.to);
     figures.push_back({s.number, s.to, s.caption});
   }
