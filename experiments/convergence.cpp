@@ -5,7 +5,7 @@
 //
 //     u(x, y) = sin(k x) cos(k y) + x y / 10,   k = pi / 3,   so  f = 2 k^2 sin(k x) cos(k y),
 //
-// Dirichlet data u on every interface node (the BE mesh's nodes), on meshes of levels 4..8.
+// Dirichlet data u on every interface node (the BE mesh's nodes), on meshes of levels 4..9.
 // Elements: P1 triangles, isoparametric bilinear Q1 quadrilaterals, and mixed meshes of both.
 // The errors are measured on the mesh's own (polygonal) domain against the exact u, with
 // quadrature exact enough not to pollute them (7-point degree-5 rule on triangles, 3x3 Gauss
@@ -221,11 +221,12 @@ int main(int argc, char** argv) {
     int first, last;
   };
   // Quad meshes split every element into 3 or 4 quads, so they start one level lower.
-  const std::vector<Run> runs{{ElementKind::Tri, 4, 8}, {ElementKind::Mixed, 4, 8}, {ElementKind::Quad, 3, 7}};
+  const std::vector<Run> runs{{ElementKind::Tri, 4, 9}, {ElementKind::Mixed, 4, 9}, {ElementKind::Quad, 3, 8}};
   std::ostringstream md, csv;
   md << "# Poisson convergence on " << std::filesystem::path(input).filename().string() << "\n\n"
      << "u = sin(kx) cos(ky) + xy/10, k = pi/3; Dirichlet data on the interface nodes; uniform global "
-        "level. Rates are slopes between consecutive levels.\n";
+        "level. Rates are slopes between consecutive levels, given only where h shrinks by 25% or more (at low "
+        "levels the thin parts are refined whatever the level).\n";
   csv << "kind,level,elements,dofs,h,l2_error,h1_error,seconds\n";
   std::vector<std::pair<std::string, std::vector<Errors>>> all;
   for (const Run& run : runs) {
@@ -244,7 +245,10 @@ int main(int argc, char** argv) {
       Errors e = solve_poisson(r.fe.mesh);
       e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       char line[256];
-      if (errs.empty()) {
+      // A rate needs h to shrink: at low levels the thickness rule and the repairs refine the
+      // thin parts of the flange whatever the level, so consecutive levels can have nearly the
+      // same h (or a larger one), and a slope over them means nothing.
+      if (errs.empty() || errs.back().h / e.h < 1.25) {
         std::snprintf(line, sizeof line, "| %d | %zu | %zu | %.4g | %.3e | - | %.3e | - | %.2f |\n", level, e.elements,
                       e.dofs, e.h, e.l2, e.h1, e.seconds);
       } else {
