@@ -142,6 +142,38 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
   return removed;
 }
 
+std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep) {
+  std::vector<std::int32_t> comp(t.n_leaves(), -1);
+  std::vector<std::size_t> size;
+  for (std::size_t s0 = 0; s0 < t.n_leaves(); ++s0) {
+    if (!in[s0] || comp[s0] >= 0) continue;
+    const std::int32_t c = static_cast<std::int32_t>(size.size());
+    std::size_t n = 0;
+    std::vector<std::size_t> stack{s0};
+    comp[s0] = c;
+    while (!stack.empty()) {
+      const std::size_t i = stack.back();
+      stack.pop_back();
+      ++n;
+      for (int f = 0; f < Cube<3>::n_faces; ++f)
+        for (std::size_t j : face_neighbours(t, i, f))
+          if (in[j] && comp[j] < 0) comp[j] = c, stack.push_back(j);
+    }
+    size.push_back(n);
+  }
+  if (static_cast<int>(size.size()) <= n_keep) return 0;
+  // The n_keep largest (ties: the first found) stay.
+  std::vector<std::int32_t> order(size.size());
+  for (std::size_t c = 0; c < size.size(); ++c) order[c] = static_cast<std::int32_t>(c);
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t a, std::int32_t b) { return size[a] > size[b]; });
+  std::vector<std::uint8_t> keep(size.size(), 0);
+  for (int k = 0; k < n_keep; ++k) keep[order[k]] = 1;
+  std::size_t removed = 0;
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    if (in[i] && !keep[comp[i]]) in[i] = 0, ++removed;
+  return removed;
+}
+
 std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction) {
   if (fraction <= 0) return 0;
   std::size_t removed = 0;

@@ -88,6 +88,11 @@ struct OctantComplexResult {
 /// must each be face-connected. Returns how many octants were dropped.
 std::size_t remove_pinches(const Orthtree<3>& t, Flags& in);
 
+/// Keep the `n_keep` largest face-connected components of the interior octants, drop the others
+/// (islands left in parts thinner than the octants would be extra solids). Returns how many
+/// octants were dropped.
+std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep);
+
 /// Drop interior octants whose free faces come nearer the surface than `fraction` of their size.
 std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction);
 

@@ -10,6 +10,7 @@
 #include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
+#include "dim3/tet_optimize.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -159,6 +160,15 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
   return moved;
 }
 
+/// Nodes the optimisation must not move: feature corners, and with `features` the nodes
+/// snapped onto feature lines too.
+std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe, bool features) {
+  std::vector<std::uint8_t> fixed(fe.mesh.points.size(), 0);
+  for (std::size_t v = 0; v < oc.snapped.size() && v < fixed.size(); ++v)
+    fixed[v] = oc.snapped[v] == 2 || (features && oc.snapped[v] == 1) ? 1 : 0;
+  return fixed;
+}
+
 }  // namespace
 
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
@@ -201,8 +211,11 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer);
     r.n_peeled = peel(tree, in, peel_points);
     r.n_pinches_dropped = remove_pinches(tree, in);
+    r.n_islands_dropped = keep_largest_components(tree, in, s.n_components());
+    if (r.n_islands_dropped > 0) r.n_pinches_dropped += remove_pinches(tree, in);
     say("interior octants: " + std::to_string(r.n_buffer_dropped) + " dropped by the buffer rule, " +
-        std::to_string(r.n_peeled) + " peeled, " + std::to_string(r.n_pinches_dropped) + " for pinches");
+        std::to_string(r.n_peeled) + " peeled, " + std::to_string(r.n_pinches_dropped) + " for pinches, " +
+        std::to_string(r.n_islands_dropped) + " in islands");
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
 
     say("boundary octants: projecting the free faces onto the surface");
@@ -219,6 +232,17 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       // Feature snaps that invert an element are undone, then the templates are redone.
       for (int round = 0;; ++round) {
         fe = tetrahedralize(tree, oc.complex, surface_point);
+        {
+          // Untangle by moving nodes (interior ones freely, surface ones on the surface,
+          // corners not at all) before giving up snaps or refining.
+          TetOptimizeOptions to;
+          to.untangle_only = true;
+          to.max_sweeps = opt.untangle_sweeps;
+          to.fixed = fixed_nodes(oc.complex, fe, false);
+          to.project = surface_point;
+          const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+          r.n_untangle_moves += ts.moves;
+        }
         const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
         std::set<std::int32_t> revert;
         for (std::size_t e : bad) {
@@ -256,6 +280,17 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       const SmoothStats ss = smooth(fe.mesh, so);
       r.n_smoothing_accepted = ss.moves_accepted;
       r.n_smoothing_rejected = ss.moves_rejected;
+      if (opt.optimize_sweeps > 0) {
+        // Sliver removal: raise each node's worst dihedral angle (surface nodes slide on the
+        // surface; feature nodes stay on their features).
+        TetOptimizeOptions to;
+        to.max_sweeps = opt.optimize_sweeps;
+        to.target_dihedral_deg = opt.target_dihedral_deg;
+        to.fixed = fixed_nodes(oc.complex, fe, true);
+        to.project = surface_point;
+        const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+        r.n_optimize_moves = ts.moves;
+      }
       clock.lap("smoothing");
       for (std::size_t e : inverted_elements(fe.mesh))
         problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});

@@ -27,7 +27,10 @@ struct Options3d {
   bool snap_features = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
-  int untangle_rounds = 16;           ///< rounds of moving surface nodes of inverted tets
+  int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
+  int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
+  int optimize_sweeps = 8;           ///< node-by-node dihedral-angle sweeps after smoothing
+  double target_dihedral_deg = 20.0; ///< nodes whose tets all reach this angle are left alone
   int max_repairs = 12;              ///< local refinements when the construction needs them
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
@@ -44,12 +47,15 @@ struct Result3d {
   std::size_t n_leaves_subdivided = 0;
   std::size_t n_buffer_dropped = 0;
   std::size_t n_pinches_dropped = 0;
+  std::size_t n_islands_dropped = 0;  ///< interior octants outside the largest components
   std::size_t n_untangled = 0;       ///< surface node moves that unfolded inverted tets
   std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes
   std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
   int n_repairs = 0;
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
+  std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
+  std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
   std::vector<StageTime3> times;
 };
 

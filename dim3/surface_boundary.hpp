@@ -10,6 +10,8 @@
 //     that a cell spans at most `arc` radians of the surface's bending; kappa of an edge is its
 //     dihedral angle / the distance between its triangles' centroids (smooth edges only),
 //     averaged at each vertex, and a triangle's kappa is the mean of its vertices',
+//   - the thickness level of every triangle the box meets: log2(root side * thickness_cells /
+//     thickness), the thickness measured along the inward normal from the centroid,
 // capped by max_level (set_max_level).
 
 #include <string>
@@ -28,6 +30,10 @@ struct SurfaceOptions {
   double max_level = 8.0;
   double feature_extra_levels = 1.0;
   double arc = 0.5;  ///< radians of bending one cell may span
+  /// Octants wanted across the thickness of the solid (ray from each triangle inwards); 0 = off.
+  /// Off by default: measured at level 4 it refines spool and rotor where the boundary octants
+  /// then fold (spool valid without, invalid with), and elephant's topology is not fixed by it.
+  double thickness_cells = 0.0;
 };
 
 class SurfaceBoundary final : public Boundary<3> {

@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "core/validate.hpp"
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
+#include "dim3/tet_optimize.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -52,4 +54,58 @@ TEST_CASE("mesh3d refuses an open surface with exit 1 and writes nothing", "[pip
   CHECK(WEXITSTATUS(status) == 1);
   CHECK_FALSE(std::filesystem::exists(out));
   std::filesystem::remove(out.string() + ".err");
+}
+
+// tet_optimize: a cube split into 12 cones from a centre node; the centre pushed out of the cube
+// inverts some cones, the untangling brings it back, and the angle search never lowers the
+// minimum dihedral angle.
+namespace {
+
+Mesh<3> cube_cones(const P3& centre) {
+  Mesh<3> m;
+  for (int k = 0; k < 8; ++k) m.add_point(P3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+  const VertexId c = m.add_point(centre);
+  // Faces as corner quads, counter-clockwise seen from outside.
+  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces)
+    for (const auto& t : {std::array<int, 3>{f[0], f[1], f[2]}, std::array<int, 3>{f[0], f[2], f[3]}})
+      m.solid.add(ElemType::Tet4, {VertexId{t[0]}, VertexId{t[2]}, VertexId{t[1]}, c});
+  return m;
+}
+
+std::size_t n_inverted(const Mesh<3>& m) {
+  std::size_t n = 0;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const auto p = element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, m.points);
+    if (signed_measure<3>(ElemType::Tet4, p.span()) <= 0) ++n;
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("tet_optimize untangles a displaced centre node and keeps the corners", "[pipeline3d][tet_optimize]") {
+  Mesh<3> m = cube_cones(P3(0.5, 0.5, 0.5));
+  REQUIRE(n_inverted(m) == 0);
+  m = cube_cones(P3(1.4, 0.3, 0.6));
+  REQUIRE(n_inverted(m) > 0);
+  std::vector<BoundaryLocation> where(m.points.size());
+  TetOptimizeOptions to;
+  to.untangle_only = true;
+  to.fixed.assign(m.points.size(), 0);
+  for (int k = 0; k < 8; ++k) to.fixed[k] = 1;
+  const TetOptimizeStats st = optimize_tets(m, where, to);
+  CHECK(st.inverted_before > 0);
+  CHECK(st.inverted_after == 0);
+  CHECK(n_inverted(m) == 0);
+  for (int k = 0; k < 8; ++k) CHECK(m.points[k] == P3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+
+  TetOptimizeOptions tq;
+  tq.fixed = to.fixed;
+  tq.target_dihedral_deg = 60.0;
+  const TetOptimizeStats sq = optimize_tets(m, where, tq);
+  CHECK(sq.inverted_after == 0);
+  CHECK(sq.min_dihedral_after_deg >= sq.min_dihedral_before_deg);
+  // The best centre is the cube's centre: every cone then has a 45 degree dihedral angle.
+  CHECK(sq.min_dihedral_after_deg > 38.0);
 }

@@ -1,0 +1,241 @@
+#include "dim3/tet_optimize.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+using P3 = Point<3>;
+using Tet = std::array<std::int32_t, 4>;
+
+constexpr double pi = 3.14159265358979323846;
+
+/// Signed mean ratio 6 sqrt(2) V / l_rms^3 (1 for the regular tetrahedron).
+double mean_ratio_volume(const P3& a, const P3& b, const P3& c, const P3& d) {
+  const P3 ab = b - a, ac = c - a, ad = d - a;
+  const double v6 = ab.dot(ac.cross(ad));
+  const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + (c - b).squaredNorm() +
+                     (d - b).squaredNorm() + (d - c).squaredNorm()) /
+                    6.0;
+  if (l2 <= 0) return -1.0;
+  return std::sqrt(2.0) * v6 / (l2 * std::sqrt(l2));
+}
+
+/// Cosine of the smallest dihedral angle (largest cosine over the six edges).
+double max_dihedral_cos(const P3& a, const P3& b, const P3& c, const P3& d) {
+  // Outward (for positive orientation) face normals opposite a, b, c, d.
+  const std::array<P3, 4> n = {(c - b).cross(d - b), (d - a).cross(c - a), (b - a).cross(d - a),
+                               (c - a).cross(b - a)};
+  std::array<double, 4> len{};
+  for (int i = 0; i < 4; ++i) len[i] = n[i].norm();
+  double best = -1.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      if (len[i] <= 0 || len[j] <= 0) return 1.0;
+      best = std::max(best, -n[i].dot(n[j]) / (len[i] * len[j]));
+    }
+  return std::clamp(best, -1.0, 1.0);
+}
+
+struct Optimizer {
+  Mesh<3>& mesh;
+  std::vector<BoundaryLocation>& where;
+  const TetOptimizeOptions& opt;
+  std::vector<Tet> tets;
+  std::vector<std::int32_t> start, incident;  // CSR node -> tets
+  std::vector<std::int32_t> nb_start, nbs;    // CSR node -> neighbour nodes
+
+  double quality_at(std::int32_t t, std::int32_t v, const P3& x) const {
+    std::array<P3, 4> p;
+    for (int k = 0; k < 4; ++k) p[k] = tets[t][k] == v ? x : mesh.points[tets[t][k]];
+    return tet_search_quality(p[0], p[1], p[2], p[3]);
+  }
+  double worst_at(std::int32_t v, const P3& x, std::int32_t* which = nullptr) const {
+    double w = std::numeric_limits<double>::infinity();
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const double q = quality_at(incident[k], v, x);
+      if (q < w) {
+        w = q;
+        if (which) *which = incident[k];
+      }
+    }
+    return w;
+  }
+  /// Like worst_at, but stops as soon as one tetrahedron is at or below `bound` (the answer
+  /// is then some value <= bound).
+  double worst_above(std::int32_t v, const P3& x, double bound) const {
+    double w = std::numeric_limits<double>::infinity();
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      w = std::min(w, quality_at(incident[k], v, x));
+      if (w <= bound) return w;
+    }
+    return w;
+  }
+  P3 gradient(std::int32_t t, std::int32_t v, const P3& x, double h) const {
+    P3 g;
+    for (int d = 0; d < 3; ++d) {
+      P3 xp = x, xm = x;
+      xp[d] += h;
+      xm[d] -= h;
+      g[d] = (quality_at(t, v, xp) - quality_at(t, v, xm)) / (2 * h);
+    }
+    return g;
+  }
+  bool is_surface(std::int32_t v) const {
+    return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0;
+  }
+  bool movable(std::int32_t v) const {
+    if (!opt.fixed.empty() && opt.fixed[v]) return false;
+    if (is_surface(v) && !opt.project) return false;
+    return start[v + 1] > start[v];
+  }
+
+  /// One local search at node v; returns true if it moved.
+  bool relax(std::int32_t v) {
+    const P3 x0 = mesh.points[v];
+    std::int32_t worst_tet = -1;
+    const double f0 = worst_at(v, x0, &worst_tet);
+    if (opt.untangle_only ? f0 > 0 : f0 >= opt.target_dihedral_deg * pi / 180.0) return false;
+    double len = 0.0;
+    for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) len += (mesh.points[nbs[k]] - x0).norm();
+    len /= std::max<std::int32_t>(1, nb_start[v + 1] - nb_start[v]);
+    if (len <= 0) return false;
+    const double h = 1e-4 * len;
+
+    std::vector<P3> dirs;
+    const P3 g = gradient(worst_tet, v, x0, h);
+    if (g.norm() > 0) dirs.push_back(g.normalized());
+    P3 sum = P3::Zero();
+    const double margin = f0 <= 0 ? 0.0 : 0.02;
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const std::int32_t t = incident[k];
+      const double q = quality_at(t, v, x0);
+      if (q <= f0 + margin || (f0 <= 0 && q <= 0)) {
+        const P3 gt = gradient(t, v, x0, h);
+        if (gt.norm() > 0) sum += gt.normalized();
+      }
+    }
+    if (sum.norm() > 0) dirs.push_back(sum.normalized());
+
+    std::vector<P3> cands;
+    P3 centroid = P3::Zero();
+    for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) centroid += mesh.points[nbs[k]];
+    centroid /= std::max<std::int32_t>(1, nb_start[v + 1] - nb_start[v]);
+    cands.push_back(centroid);
+    cands.push_back(0.5 * (centroid + x0));
+    for (const P3& d : dirs)
+      for (double s : {0.25, 0.08, 0.025, 0.006}) cands.push_back(x0 + s * len * d);
+
+    const bool surf = is_surface(v);
+    double best = f0;
+    P3 best_x = x0;
+    BoundaryLocation best_w = surf ? where[v] : BoundaryLocation{};
+    for (const P3& c : cands) {
+      P3 x = c;
+      BoundaryLocation w;
+      if (surf) std::tie(x, w) = opt.project(c);
+      const double f = worst_above(v, x, best + 1e-12);
+      if (f > best + 1e-12) best = f, best_x = x, best_w = w;
+    }
+    if (best_x == x0) return false;
+    mesh.points[v] = best_x;
+    if (surf) where[v] = best_w;
+    return true;
+  }
+};
+
+}  // namespace
+
+double tet_search_quality(const P3& a, const P3& b, const P3& c, const P3& d) {
+  const double r = mean_ratio_volume(a, b, c, d);
+  if (!(r > 1e-9)) return std::min(r, 0.0) - 1.0;
+  return std::acos(max_dihedral_cos(a, b, c, d));
+}
+
+double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) {
+  return std::acos(max_dihedral_cos(a, b, c, d)) * 180.0 / pi;
+}
+
+TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}};
+  const std::size_t n = mesh.points.size();
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
+    const VertexId* v = mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    o.tets.push_back({v[0].v, v[1].v, v[2].v, v[3].v});
+  }
+  o.start.assign(n + 1, 0);
+  for (const Tet& t : o.tets)
+    for (std::int32_t v : t) ++o.start[v + 1];
+  for (std::size_t v = 0; v < n; ++v) o.start[v + 1] += o.start[v];
+  o.incident.resize(o.start[n]);
+  {
+    std::vector<std::int32_t> fill(o.start.begin(), o.start.end() - 1);
+    for (std::size_t t = 0; t < o.tets.size(); ++t)
+      for (std::int32_t v : o.tets[t]) o.incident[fill[v]++] = static_cast<std::int32_t>(t);
+  }
+  o.nb_start.assign(n + 1, 0);
+  {
+    std::vector<std::int32_t> tmp;
+    for (std::size_t v = 0; v < n; ++v) {
+      tmp.clear();
+      for (std::int32_t k = o.start[v]; k < o.start[v + 1]; ++k)
+        for (std::int32_t u : o.tets[o.incident[k]])
+          if (u != static_cast<std::int32_t>(v)) tmp.push_back(u);
+      std::sort(tmp.begin(), tmp.end());
+      tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
+      o.nbs.insert(o.nbs.end(), tmp.begin(), tmp.end());
+      o.nb_start[v + 1] = static_cast<std::int32_t>(o.nbs.size());
+    }
+  }
+
+  TetOptimizeStats st;
+  const auto measure = [&](std::size_t& inverted, double& min_deg) {
+    inverted = 0;
+    min_deg = 180.0;
+    for (const Tet& t : o.tets) {
+      const P3 &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]], &d = mesh.points[t[3]];
+      const double q = tet_search_quality(a, b, c, d);
+      if (q < 0) {
+        ++inverted;
+        min_deg = 0.0;
+      } else {
+        min_deg = std::min(min_deg, q * 180.0 / pi);
+      }
+    }
+  };
+  measure(st.inverted_before, st.min_dihedral_before_deg);
+
+  // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
+  const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
+  std::vector<std::uint8_t> active(n, 0);
+  for (const Tet& t : o.tets) {
+    const double q = tet_search_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+    if (opt.untangle_only ? q <= 0 : q < target)
+      for (std::int32_t v : t) active[v] = 1;
+  }
+  for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
+    std::vector<std::uint8_t> next(n, 0);
+    std::size_t moved = 0;
+    for (std::size_t v = 0; v < n; ++v) {
+      if (!active[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+      if (!o.relax(static_cast<std::int32_t>(v))) continue;
+      ++moved;
+      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1;
+      next[v] = 1;
+    }
+    st.sweeps = sweep + 1;
+    st.moves += moved;
+    if (moved == 0) break;
+    active.swap(next);
+  }
+  measure(st.inverted_after, st.min_dihedral_after_deg);
+  return st;
+}
+
+}  // namespace febemesh::dim3

@@ -1,0 +1,59 @@
+#pragma once
+// Untangling and quality optimisation of a tetrahedral mesh by moving one node at a time
+// (Gauss-Seidel local search, Freitag & Knupp style): a node moves to the candidate position
+// that most raises the worst quality among its tetrahedra. The quality is lexicographic: any
+// tetrahedron of positive volume beats any inverted or flat one; inverted ones are ranked by
+// their signed mean-ratio volume 6 sqrt(2) V / l_rms^3 (so the search untangles), positive ones
+// by their smallest dihedral angle (so the same search then removes slivers).
+//
+// Candidates: steps along the gradient of the worst tetrahedron's quality and of the sum over
+// the nearly worst ones, the centroid of the node's neighbours and halfway to it. Surface nodes
+// (where.patch >= 0) move too but every candidate is projected back onto the surface first, so
+// they stay on it exactly; nodes flagged fixed (feature corners) never move. A move is accepted
+// only if it strictly raises the node's worst quality, so no tetrahedron ever inverts that was
+// not inverted, and the mesh's minimum never drops.
+
+#include <cstdint>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "core/boundary.hpp"
+#include "core/mesh.hpp"
+
+namespace febemesh::dim3 {
+
+using SurfaceProjection = std::function<std::pair<Point<3>, BoundaryLocation>(const Point<3>&)>;
+
+struct TetOptimizeOptions {
+  int max_sweeps = 40;
+  /// Nodes whose worst dihedral angle is at least this stay put (degrees).
+  double target_dihedral_deg = 30.0;
+  /// Per node: 1 = never moves. Empty = none.
+  std::vector<std::uint8_t> fixed;
+  /// Surface nodes are those with where[v].patch >= 0; without a projection they stay put.
+  SurfaceProjection project;
+  /// Only untangle: stop a node as soon as its tetrahedra are all positive.
+  bool untangle_only = false;
+};
+
+struct TetOptimizeStats {
+  int sweeps = 0;
+  std::size_t moves = 0;
+  std::size_t inverted_before = 0, inverted_after = 0;
+  double min_dihedral_before_deg = 0.0, min_dihedral_after_deg = 0.0;
+};
+
+/// Quality of one tetrahedron (a, b, c, d in Gmsh order) as used by the search: the smallest
+/// dihedral angle in radians when the volume is positive (above 1e-9 of the mean-ratio scale),
+/// else (signed mean ratio) - 1 <= -1.
+double tet_search_quality(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
+
+/// Smallest dihedral angle of a tetrahedron in degrees (0 when flat); sign-free.
+double tet_min_dihedral_deg(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
+
+/// Optimises mesh.points in place (the solid must be all Tet4); `where` (one per node) is
+/// updated for surface nodes that move.
+TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt);
+
+}  // namespace febemesh::dim3
