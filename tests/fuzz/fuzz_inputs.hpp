@@ -4,9 +4,13 @@
 // InputError is the expected outcome of bad input and is swallowed here; any other exception
 // escapes (the fuzz driver turns it into a crash), as do crashes and sanitizer reports.
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <string>
 #include <string_view>
+
+#include <unistd.h>
 
 #include "core/error.hpp"
 #include "dim2/curve_boundary.hpp"
@@ -51,6 +55,22 @@ inline void off_input(std::string_view data) {
     (void)dim3::read_off(in, "fuzz.off");
   } catch (const InputError&) {
   }
+}
+
+/// The bytes as an .stl file read through OpenMesh (read_with_openmesh, as read_surface does
+/// for .stl), then indexed as a Surface. The file is per process, so parallel jobs do not clash.
+inline void stl_input(std::string_view data) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("febemesh_fuzz_" + std::to_string(::getpid()) + ".stl");
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+  }
+  try {
+    (void)dim3::Surface(dim3::read_with_openmesh(path.string()));
+  } catch (const InputError&) {
+  }
+  std::filesystem::remove(path);
 }
 
 }  // namespace febemesh::fuzz
