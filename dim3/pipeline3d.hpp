@@ -29,8 +29,8 @@ struct Options3d {
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
   int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
   int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
-  int optimize_sweeps = 8;           ///< node-by-node dihedral-angle sweeps after smoothing
-  double target_dihedral_deg = 20.0; ///< nodes whose tets all reach this angle are left alone
+  int optimize_sweeps = 12;          ///< node-by-node dihedral-angle sweeps after smoothing
+  double target_dihedral_deg = 30.0; ///< nodes whose tets all reach this angle are left alone
   int max_repairs = 12;              ///< local refinements when the construction needs them
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
