@@ -82,12 +82,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
 
   // internal[L]: sorted Morton keys of internal cells at level L. Parents of the leaves come out
   // sorted from the Morton-ordered leaves (masking low bits is monotone).
-  // Each level gets the capacity of an upper bound (its leaves' count); pages of a large
-  // reservation are not touched, so an unused bound costs address space, not memory.
-  std::vector<std::size_t> leaves_at(std::size_t(deepest) + 1, 0);
-  for (const auto& c : leaves) ++leaves_at[c.level];
   std::vector<std::vector<std::uint64_t>> internal(deepest);
-  for (int pl = 0; pl < deepest; ++pl) internal[pl].reserve(leaves_at[pl + 1]);
   for (const auto& c : leaves) {
     if (c.level == 0) continue;
     const int pl = c.level - 1;

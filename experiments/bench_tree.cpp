@@ -6,8 +6,8 @@
 // 2:1 balance grades the tree away from it. Raising k from small to large walks the leaf count
 // from about 10^4 to 10^7 in both dimensions.
 //
-// Usage: bench_tree [max_leaves] [repetitions]   (defaults 1.2e7, 3; the largest run stops below
-// max_leaves; times are the best of the repetitions)
+// Usage: bench_tree [max_leaves] [repetitions] [dim]   (defaults 1.2e7, 3, both; the largest run
+// stops below max_leaves; times are the best of the repetitions)
 // Output: a table on stdout and results/bench_tree.csv.
 
 #include <algorithm>
@@ -224,9 +224,14 @@ int main(int argc, char** argv) {
 
   // A band around a curve holds about c 2^k leaves in 2D and c 4^k in 3D: each step of k
   // doubles (2D) or quadruples (3D) the work. Stop before the next step would pass max_leaves.
-  for (int k = 8; 2.2 * double(run_isolated<2>(k, reps, csv)) < max_leaves; ++k) {
+  const int only_dim = argc > 3 ? std::atoi(argv[3]) : 0;
+  if (only_dim != 3) {
+    for (int k = 8; 2.2 * double(run_isolated<2>(k, reps, csv)) < max_leaves; ++k) {
+    }
   }
-  for (int k = 5; 4.4 * double(run_isolated<3>(k, reps, csv)) < max_leaves; ++k) {
+  if (only_dim != 2) {
+    for (int k = 5; 4.4 * double(run_isolated<3>(k, reps, csv)) < max_leaves; ++k) {
+    }
   }
   std::printf("\nwrote %s\n", csv.c_str());
   return 0;
