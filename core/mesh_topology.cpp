@@ -145,6 +145,45 @@ int orientation_of(const Facet& f) {
   return next < prev ? 1 : -1;
 }
 
+namespace {
+
+/// Sorts by (key, element, local facet). When every key has at most two nodes (2D meshes) the
+/// order is that of two packed 64-bit words, sorted without comparing key arrays element by
+/// element; otherwise the four ids are compared in turn. Same order either way.
+void sort_uses(std::vector<FacetUse>& uses) {
+  const bool two_nodes = std::all_of(uses.begin(), uses.end(), [](const FacetUse& u) { return u.key.v[2] < 0; });
+  if (two_nodes) {
+    struct Packed {
+      std::uint64_t key, rest;
+      std::uint32_t index;
+    };
+    std::vector<Packed> packed(uses.size());
+    for (std::size_t i = 0; i < uses.size(); ++i) {
+      const FacetUse& u = uses[i];
+      // Ids are >= -1: offset by one so that the unsigned order is the signed one.
+      const auto a = static_cast<std::uint64_t>(static_cast<std::int64_t>(u.key.v[0]) + 1);
+      const auto b = static_cast<std::uint64_t>(static_cast<std::int64_t>(u.key.v[1]) + 1);
+      const auto rest = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u.elem.v)) << 8) |
+                        static_cast<std::uint8_t>(u.local);
+      packed[i] = {(a << 32) | b, rest, static_cast<std::uint32_t>(i)};
+    }
+    std::sort(packed.begin(), packed.end(),
+              [](const Packed& x, const Packed& y) { return x.key != y.key ? x.key < y.key : x.rest < y.rest; });
+    std::vector<FacetUse> sorted(uses.size());
+    for (std::size_t i = 0; i < packed.size(); ++i) sorted[i] = uses[packed[i].index];
+    uses = std::move(sorted);
+    return;
+  }
+  std::sort(uses.begin(), uses.end(), [](const FacetUse& a, const FacetUse& b) {
+    for (int k = 0; k < 4; ++k)
+      if (a.key.v[k] != b.key.v[k]) return a.key.v[k] < b.key.v[k];
+    if (a.elem.v != b.elem.v) return a.elem.v < b.elem.v;
+    return a.local < b.local;
+  });
+}
+
+}  // namespace
+
 std::vector<FacetUse> facet_uses(const Elements& els) {
   std::vector<FacetUse> uses;
   std::size_t total = 0;
@@ -157,11 +196,7 @@ std::vector<FacetUse> facet_uses(const Elements& els) {
       uses.push_back({key_of(fc), id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(orientation_of(fc))});
     }
   }
-  std::sort(uses.begin(), uses.end(), [](const FacetUse& a, const FacetUse& b) {
-    if (a.key != b.key) return a.key < b.key;
-    if (a.elem.v != b.elem.v) return a.elem.v < b.elem.v;
-    return a.local < b.local;
-  });
+  sort_uses(uses);
   return uses;
 }
 

@@ -1,9 +1,13 @@
-// MSH 4.1 ASCII parser: a whitespace tokenizer that tracks lines for error messages.
+// MSH 4.1 parser: a whitespace tokenizer that tracks lines for error messages; in binary files the
+// section data are read as raw fields (int32, size_t of the header's size, double) instead.
 
 #include "core/read_msh.hpp"
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -28,6 +32,7 @@ class Tokens {
     return pos_ >= s_.size();
   }
   std::string_view word() {
+    in_data_ = false;
     skip_space();
     if (pos_ >= s_.size()) fail("unexpected end of file");
     const std::size_t start = pos_;
@@ -43,6 +48,55 @@ class Tokens {
     if (pos_ >= s_.size() || s_[pos_] != '"') fail("unterminated quoted name");
     return std::string(s_.substr(start, pos_++ - start));
   }
+  /// Binary mode: data fields are raw bytes; `size_bytes` is the file's size_t width (4 or 8).
+  void set_binary(int size_bytes) {
+    binary_ = true;
+    size_bytes_ = size_bytes;
+  }
+  bool binary() const { return binary_; }
+  /// A field of type int (entity dimensions, entity tags, element types, flags).
+  int int_field(const char* what) {
+    if (!binary_) return integer<int>(what);
+    std::int32_t v;
+    raw(&v, sizeof v, what);
+    return v;
+  }
+  /// A field of type size_t (counts, node and element tags).
+  std::int64_t size_field(const char* what) {
+    if (!binary_) return integer<std::int64_t>(what);
+    std::uint64_t v = 0;
+    if (size_bytes_ == 4) {
+      std::uint32_t w;
+      raw(&w, sizeof w, what);
+      v = w;
+    } else {
+      raw(&v, sizeof v, what);
+    }
+    if (v > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+      fail(std::string(what) + " out of range");
+    return static_cast<std::int64_t>(v);
+  }
+  double real_field(const char* what) {
+    if (!binary_) return real(what);
+    double v;
+    raw(&v, sizeof v, what);
+    return v;
+  }
+  /// Raw bytes of a binary file (the 1 after the header).
+  void raw(void* out, std::size_t n, const char* what) {
+    if (!in_data_) {
+      // Binary data start on the line after the section keyword.
+      while (pos_ < s_.size() && s_[pos_] != '\n') ++pos_;
+      if (pos_ < s_.size()) ++pos_, ++line_;
+      in_data_ = true;
+    }
+    if (s_.size() - pos_ < n) fail("unexpected end of file in binary data (" + std::string(what) + ")");
+    std::memcpy(out, s_.data() + pos_, n);
+    pos_ += n;
+  }
+  /// Upper bound on how many fields of `bytes` each the rest of the file can hold (reserve guard).
+  std::size_t remaining(std::size_t bytes) const { return (s_.size() - pos_) / std::max<std::size_t>(bytes, 1); }
+
   template <class Int> Int integer(const char* what) {
     const std::string_view w = word();
     Int v{};
@@ -82,6 +136,9 @@ class Tokens {
   std::string_view source_;
   std::size_t pos_ = 0;
   long line_ = 1;
+  bool binary_ = false;
+  bool in_data_ = false;  ///< raw reads continue where the previous one stopped
+  int size_bytes_ = 8;
 };
 
 std::optional<ElemType> from_gmsh(int code) {
@@ -115,8 +172,16 @@ template <int Dim> Mesh<Dim> parse_msh(std::string_view text, std::string_view s
     if (section == "$MeshFormat") {
       const std::string_view version = tok.word();
       if (version != "4.1") tok.fail("MSH version " + std::string(version) + " is not supported (need 4.1)");
-      if (tok.integer<int>("file type") != 0) tok.fail("binary MSH is not supported");
-      tok.integer<int>("data size");
+      const int file_type = tok.integer<int>("file type");
+      const int data_size = tok.integer<int>("data size");
+      if (file_type != 0 && file_type != 1) tok.fail("file type " + std::to_string(file_type) + " (need 0 or 1)");
+      if (file_type == 1) {
+        if (data_size != 4 && data_size != 8) tok.fail("data size " + std::to_string(data_size) + " (need 4 or 8)");
+        tok.set_binary(data_size);
+        std::int32_t one = 0;
+        tok.raw(&one, sizeof one, "byte order mark");
+        if (one != 1) tok.fail("binary MSH in the other byte order is not supported");
+      }
       tok.expect("$EndMeshFormat");
       seen_format = true;
     } else if (!seen_format) {
@@ -130,52 +195,52 @@ template <int Dim> Mesh<Dim> parse_msh(std::string_view text, std::string_view s
       }
       tok.expect("$EndPhysicalNames");
     } else if (section == "$Entities") {
-      long count[4];
-      for (auto& c : count) c = tok.integer<long>("number of entities");
+      std::int64_t count[4];
+      for (auto& c : count) c = tok.size_field("number of entities");
       for (int dim = 0; dim < 4; ++dim) {
-        for (long i = 0; i < count[dim]; ++i) {
-          const int tag = tok.integer<int>("entity tag");
-          for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) tok.real("entity coordinate");
-          const auto n_phys = tok.integer<long>("number of physical tags");
+        for (std::int64_t i = 0; i < count[dim]; ++i) {
+          const int tag = tok.int_field("entity tag");
+          for (int k = 0; k < (dim == 0 ? 3 : 6); ++k) tok.real_field("entity coordinate");
+          const auto n_phys = tok.size_field("number of physical tags");
           auto& phys = entity_phys[{dim, tag}];
-          for (long k = 0; k < n_phys; ++k) phys.push_back(tok.integer<int>("physical tag"));
+          for (std::int64_t k = 0; k < n_phys; ++k) phys.push_back(tok.int_field("physical tag"));
           if (dim > 0) {
-            const auto n_bound = tok.integer<long>("number of bounding entities");
-            for (long k = 0; k < n_bound; ++k) tok.integer<int>("bounding entity");
+            const auto n_bound = tok.size_field("number of bounding entities");
+            for (std::int64_t k = 0; k < n_bound; ++k) tok.int_field("bounding entity");
           }
         }
       }
       tok.expect("$EndEntities");
     } else if (section == "$Nodes") {
-      const auto n_blocks = tok.integer<long>("number of node blocks");
-      const auto n_nodes = tok.integer<long>("number of nodes");
-      tok.integer<std::int64_t>("min node tag");
-      tok.integer<std::int64_t>("max node tag");
-      nodes.reserve(static_cast<std::size_t>(std::max(0L, n_nodes)));
-      for (long b = 0; b < n_blocks; ++b) {
-        const int dim = tok.integer<int>("entity dimension");
-        tok.integer<int>("entity tag");
-        const int parametric = tok.integer<int>("parametric flag");
-        const auto n = tok.integer<long>("nodes in block");
+      const auto n_blocks = tok.size_field("number of node blocks");
+      const auto n_nodes = tok.size_field("number of nodes");
+      tok.size_field("min node tag");
+      tok.size_field("max node tag");
+      nodes.reserve(std::min(static_cast<std::size_t>(n_nodes), tok.remaining(2)));
+      for (std::int64_t b = 0; b < n_blocks; ++b) {
+        const int dim = tok.int_field("entity dimension");
+        tok.int_field("entity tag");
+        const int parametric = tok.int_field("parametric flag");
+        const auto n = tok.size_field("nodes in block");
         const std::size_t first = nodes.size();
-        for (long i = 0; i < n; ++i) nodes.emplace_back(tok.integer<std::int64_t>("node tag"), Point<Dim>::Zero());
-        for (long i = 0; i < n; ++i) {
+        for (std::int64_t i = 0; i < n; ++i) nodes.emplace_back(tok.size_field("node tag"), Point<Dim>::Zero());
+        for (std::int64_t i = 0; i < n; ++i) {
           double xyz[3];
-          for (double& c : xyz) c = tok.real("node coordinate");
+          for (double& c : xyz) c = tok.real_field("node coordinate");
           for (int d = 0; d < Dim; ++d) nodes[first + static_cast<std::size_t>(i)].second[d] = xyz[d];
-          if (parametric) for (int k = 0; k < dim; ++k) tok.real("parametric coordinate");
+          if (parametric) for (int k = 0; k < dim; ++k) tok.real_field("parametric coordinate");
         }
       }
       tok.expect("$EndNodes");
     } else if (section == "$Elements") {
-      const auto n_blocks = tok.integer<long>("number of element blocks");
-      for (int k = 0; k < 3; ++k) tok.integer<std::int64_t>("element counts");
-      for (long b = 0; b < n_blocks; ++b) {
+      const auto n_blocks = tok.size_field("number of element blocks");
+      for (int k = 0; k < 3; ++k) tok.size_field("element counts");
+      for (std::int64_t b = 0; b < n_blocks; ++b) {
         Block block;
-        block.dim = tok.integer<int>("entity dimension");
-        block.entity = tok.integer<int>("entity tag");
-        const int code = tok.integer<int>("element type");
-        const auto n = tok.integer<long>("elements in block");
+        block.dim = tok.int_field("entity dimension");
+        block.entity = tok.int_field("entity tag");
+        const int code = tok.int_field("element type");
+        const auto n = tok.size_field("elements in block");
         const auto type = from_gmsh(code);
         const bool wanted = block.dim == Dim || block.dim == Dim - 1;
         if (!type && wanted) tok.fail("element type " + std::to_string(code) + " is not supported");
@@ -183,9 +248,10 @@ template <int Dim> Mesh<Dim> parse_msh(std::string_view text, std::string_view s
         // Point elements (type 15) have one node; other unsupported types lie outside Dim-1..Dim.
         const int per = type ? n_nodes(*type) : (code == 15 ? 1 : -1);
         if (per < 0) tok.fail("element type " + std::to_string(code) + " is not supported");
-        for (long i = 0; i < n; ++i) {
-          RawElement el{tok.integer<std::int64_t>("element tag"), type.value_or(ElemType::Line2), {}};
-          for (int k = 0; k < per; ++k) el.nodes[k] = tok.integer<std::int64_t>("node tag");
+        if (type && wanted) block.elements.reserve(std::min(static_cast<std::size_t>(n), tok.remaining(2 * (per + 1))));
+        for (std::int64_t i = 0; i < n; ++i) {
+          RawElement el{tok.size_field("element tag"), type.value_or(ElemType::Line2), {}};
+          for (int k = 0; k < per; ++k) el.nodes[k] = tok.size_field("node tag");
           if (type && wanted) block.elements.push_back(el);
         }
         if (type && wanted) blocks.push_back(std::move(block));

@@ -1,5 +1,5 @@
 #pragma once
-// Gmsh MSH 4.1 ASCII reader into Mesh<Dim>: what write_msh writes, and reasonable files from
+// Gmsh MSH 4.1 reader (ASCII or binary) into Mesh<Dim>: what write_msh writes, and reasonable files from
 // Gmsh. Elements of the physical group "solid" go to mesh.solid, of "interface" to
 // mesh.interface; a file without groups of those names is split by dimension (Dim -> solid,
 // Dim-1 -> interface; points and other dimensions ignored). Nodes are ordered by tag, elements

@@ -75,7 +75,10 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     return std::pair{min_corner_jacobian<Dim>(t, ep.span()) > 0.0, scaled_jacobian<Dim>(t, ep.span())};
   };
 
-  std::vector<std::pair<bool, double>> before;
+  // The state of every element, refreshed where a move is accepted: the guard compares against
+  // it instead of re-evaluating the incident elements before each move (same values).
+  std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
     for (std::size_t v = 0; v < n; ++v) {
@@ -91,24 +94,22 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       if (slides) target = options.project(target);
       if (target == mesh.points[v]) continue;
 
-      before.clear();
       double old_min = std::numeric_limits<double>::infinity();
-      for (const auto e : elems) {
-        before.push_back(element_state(e));
-        old_min = std::min(old_min, before.back().second);
-      }
+      for (const auto e : elems) old_min = std::min(old_min, state[e].second);
       const Point<Dim> saved = mesh.points[v];
       mesh.points[v] = target;
       bool accept = true;
       double new_min = std::numeric_limits<double>::infinity();
+      after.clear();
       for (std::size_t k = 0; k < elems.size() && accept; ++k) {
-        const auto [positive, q] = element_state(elems[k]);
-        accept = positive || !before[k].first;
-        new_min = std::min(new_min, q);
+        after.push_back(element_state(elems[k]));
+        accept = after.back().first || !state[elems[k]].first;
+        new_min = std::min(new_min, after.back().second);
       }
       accept = accept && new_min >= old_min;
       if (accept) {
         ++stats.moves_accepted;
+        for (std::size_t k = 0; k < elems.size(); ++k) state[elems[k]] = after[k];
       } else {
         mesh.points[v] = saved;
         ++stats.moves_rejected;

@@ -1,4 +1,5 @@
-// MSH 4.1 ASCII text built in large chunks with std::to_chars (no iostream formatting).
+// MSH 4.1 text built in large chunks with std::to_chars (no iostream formatting), or the same
+// sections in binary; both spill to the file every few MiB.
 
 #include "core/write_msh.hpp"
 
@@ -8,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "core/error.hpp"
 
@@ -18,8 +20,37 @@ namespace {
 /// Appends text to a string and, when given a file, spills it in chunks of a few MiB.
 class Sink {
  public:
-  explicit Sink(std::FILE* file = nullptr, std::string path = {}) : file_(file), path_(std::move(path)) {
+  explicit Sink(bool binary, std::FILE* file = nullptr, std::string path = {})
+      : binary_(binary), file_(file), path_(std::move(path)) {
     buf_.reserve(file_ ? 2 * chunk : 1 << 16);
+  }
+  bool binary() const { return binary_; }
+  /// The bytes of a trivially copyable value (the writer runs on little-endian hosts only).
+  template <class T> void raw(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    buf_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  /// A field of the file's int type: text followed by `sep`, or 4 raw bytes.
+  Sink& i32(int v, char sep = ' ') {
+    if (binary_) raw(std::int32_t{v});
+    else integer(v) << sep;
+    return *this;
+  }
+  /// A field of the file's size_t type (counts, node and element tags).
+  Sink& size(std::uint64_t v, char sep = ' ') {
+    if (binary_) raw(v);
+    else integer(v) << sep;
+    return *this;
+  }
+  Sink& f64(double v, char sep = ' ') {
+    if (binary_) raw(v);
+    else real(v) << sep;
+    return *this;
+  }
+  /// Ends a line of text (nothing in binary, where fields have no separators).
+  Sink& eol() {
+    if (!binary_) buf_.push_back('\n');
+    return *this;
   }
   Sink& operator<<(std::string_view s) {
     buf_.append(s);
@@ -56,6 +87,7 @@ class Sink {
 
  private:
   static constexpr std::size_t chunk = 4 << 20;
+  bool binary_;
   std::FILE* file_;
   std::string path_;
   std::string buf_;
@@ -66,7 +98,7 @@ template <int Dim> void bbox_line(Sink& out, const Mesh<Dim>& mesh, const Elemen
   for (const VertexId v : els.node) b.expand(mesh.points[v.v]);
   if (els.node.empty()) b = Box<Dim>{};
   for (const auto* corner : {&b.lo, &b.hi})
-    for (int d = 0; d < 3; ++d) out.real(d < Dim ? (*corner)[d] : 0.0) << ' ';
+    for (int d = 0; d < 3; ++d) out.f64(d < Dim ? (*corner)[d] : 0.0);
 }
 
 template <int Dim> void write_blocks(Sink& out, const Elements& els, int entity_dim, std::int64_t first_tag) {
@@ -75,15 +107,14 @@ template <int Dim> void write_blocks(Sink& out, const Elements& els, int entity_
     std::size_t count = 0;
     for (const ElemType et : els.type) count += (et == type);
     if (count == 0) continue;
-    out.integer(entity_dim) << ' ' << '1' << ' ';
-    out.integer(gmsh_type(type)) << ' ';
-    out.integer(count) << '\n';
+    out.i32(entity_dim).i32(1).i32(gmsh_type(type)).size(count, '\n');
     for (std::size_t e = 0; e < els.size(); ++e) {
       if (els.type[e] != type) continue;
-      out.integer(first_tag + static_cast<std::int64_t>(e));
       const ElemId id{static_cast<std::int32_t>(e)};
-      for (int i = 0; i < els.n_nodes_of(id); ++i) out << ' ', out.integer(std::int64_t{els.nodes(id)[i].v} + 1);
-      out << '\n';
+      const int n = els.n_nodes_of(id);
+      const VertexId* v = els.nodes(id);
+      out.size(static_cast<std::uint64_t>(first_tag) + e, n == 0 ? '\n' : ' ');
+      for (int i = 0; i < n; ++i) out.size(static_cast<std::uint64_t>(v[i].v) + 1, i + 1 == n ? '\n' : ' ');
       out.maybe_flush();
     }
   }
@@ -98,78 +129,77 @@ std::size_t n_types(const Elements& els) {
 }
 
 template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh) {
-  out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  if (out.binary()) {
+    out << "$MeshFormat\n4.1 1 8\n";
+    out.raw(std::int32_t{1});  // lets a reader detect the byte order
+    out << "\n$EndMeshFormat\n";
+  } else {
+    out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
+  }
   out << "$PhysicalNames\n2\n";
   out.integer(Dim - 1) << " 2 \"interface\"\n";
   out.integer(Dim) << " 1 \"solid\"\n";
   out << "$EndPhysicalNames\n";
+  // Binary sections end with a newline before their $End line, as Gmsh writes them.
+  const std::string_view end_binary = out.binary() ? "\n" : "";
 
   // One entity per group: the interface is entity (Dim-1, 1) with physical tag 2, the solid
   // entity (Dim, 1) with physical tag 1; no bounding relations (the mesh is all there is).
   out << "$Entities\n";
-  out << (Dim == 2 ? "0 1 1 0\n" : "0 0 1 1\n");
-  out << '1' << ' ';
-  bbox_line<Dim>(out, mesh, mesh.interface);
-  out << "1 2 0\n";
-  out << '1' << ' ';
-  bbox_line<Dim>(out, mesh, mesh.solid);
-  out << "1 1 0\n";
-  out << "$EndEntities\n";
+  for (int d = 0; d < 4; ++d) out.size(d == Dim - 1 || d == Dim ? 1 : 0, d == 3 ? '\n' : ' ');
+  for (const auto& [els, phys] : {std::pair{&mesh.interface, 2}, std::pair{&mesh.solid, 1}}) {
+    out.i32(1);
+    bbox_line<Dim>(out, mesh, *els);
+    out.size(1).i32(phys).size(0, '\n');
+  }
+  out << end_binary << "$EndEntities\n";
 
   const std::size_t n = mesh.points.size();
   out << "$Nodes\n";
   if (n == 0) {
-    out << "0 0 0 0\n";
+    for (int k = 0; k < 4; ++k) out.size(0, k == 3 ? '\n' : ' ');
   } else {
-    out << "1 ";
-    out.integer(n) << " 1 ";
-    out.integer(n) << '\n';
-    out.integer(Dim) << " 1 0 ";
-    out.integer(n) << '\n';
+    out.size(1).size(n).size(1).size(n, '\n');
+    out.i32(Dim).i32(1).i32(0).size(n, '\n');
     for (std::size_t i = 0; i < n; ++i) {
-      out.integer(i + 1) << '\n';
+      out.size(i + 1, '\n');
       out.maybe_flush();
     }
     for (const auto& p : mesh.points) {
-      out.real(p[0]) << ' ';
-      out.real(p[1]) << ' ';
-      out.real(Dim == 3 ? p[Dim - 1] : 0.0) << '\n';
+      out.f64(p[0]).f64(p[1]).f64(Dim == 3 ? p[Dim - 1] : 0.0, '\n');
       out.maybe_flush();
     }
   }
-  out << "$EndNodes\n";
+  out << end_binary << "$EndNodes\n";
 
   const std::size_t ne = mesh.solid.size() + mesh.interface.size();
   out << "$Elements\n";
-  out.integer(n_types(mesh.solid) + n_types(mesh.interface)) << ' ';
-  out.integer(ne) << ' ';
-  out.integer(ne == 0 ? 0 : 1) << ' ';
-  out.integer(ne) << '\n';
+  out.size(n_types(mesh.solid) + n_types(mesh.interface)).size(ne).size(ne == 0 ? 0 : 1).size(ne, '\n');
   write_blocks<Dim>(out, mesh.solid, Dim, 1);
   write_blocks<Dim>(out, mesh.interface, Dim - 1, static_cast<std::int64_t>(mesh.solid.size()) + 1);
-  out << "$EndElements\n";
+  out << end_binary << "$EndElements\n";
 }
 
 }  // namespace
 
-template <int Dim> std::string msh_string(const Mesh<Dim>& mesh) {
-  Sink out;
+template <int Dim> std::string msh_string(const Mesh<Dim>& mesh, MshEncoding encoding) {
+  Sink out(encoding == MshEncoding::Binary);
   write<Dim>(out, mesh);
   return out.take();
 }
 
-template <int Dim> void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path) {
+template <int Dim> void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding) {
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "wb"), &std::fclose);
   if (!file) throw InputError("cannot open " + path.string() + " for writing: " + std::strerror(errno));
-  Sink out(file.get(), path.string());
+  Sink out(encoding == MshEncoding::Binary, file.get(), path.string());
   write<Dim>(out, mesh);
   out.flush();
   if (std::fflush(file.get()) != 0) throw InputError("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
-template std::string msh_string<2>(const Mesh<2>&);
-template std::string msh_string<3>(const Mesh<3>&);
-template void write_msh<2>(const Mesh<2>&, const std::filesystem::path&);
-template void write_msh<3>(const Mesh<3>&, const std::filesystem::path&);
+template std::string msh_string<2>(const Mesh<2>&, MshEncoding);
+template std::string msh_string<3>(const Mesh<3>&, MshEncoding);
+template void write_msh<2>(const Mesh<2>&, const std::filesystem::path&, MshEncoding);
+template void write_msh<3>(const Mesh<3>&, const std::filesystem::path&, MshEncoding);
 
 }  // namespace febemesh

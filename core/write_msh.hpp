@@ -5,6 +5,9 @@
 // interface element e tag n_solid + e + 1; one element block per (group, type). Doubles use the
 // shortest representation that round-trips, so the bytes are deterministic and reading back
 // gives the same points bit for bit.
+// MshEncoding::Binary writes the same sections as MSH 4.1 binary (file type 1, data size 8,
+// native little-endian): integers as int32, counts and tags as 64-bit size_t, coordinates as
+// doubles; $PhysicalNames stays text, as in Gmsh's own binary files.
 
 #include <filesystem>
 #include <string>
@@ -13,8 +16,11 @@
 
 namespace febemesh {
 
-template <int Dim> std::string msh_string(const Mesh<Dim>& mesh);
+enum class MshEncoding { Ascii, Binary };
+
+template <int Dim> std::string msh_string(const Mesh<Dim>& mesh, MshEncoding encoding = MshEncoding::Ascii);
 /// Throws InputError when the file cannot be written.
-template <int Dim> void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path);
+template <int Dim>
+void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding = MshEncoding::Ascii);
 
 }  // namespace febemesh

@@ -173,3 +173,70 @@ TEST_CASE("MSH writer throughput", "[msh][benchmark]") {
   WARN("msh_string: " << text.size() / 1e6 << " MB in " << s << " s = " << mb_per_s << " MB/s");
   CHECK(text.size() > 1000000);
 }
+
+TEMPLATE_TEST_CASE_SIG("binary MSH round trip preserves the mesh", "[msh]", ((int Dim), Dim), 2, 3) {
+  for (const bool simplices : {false, true}) {
+    Mesh<Dim> mesh = test::grid_mesh<Dim>(3, simplices, 0.1);
+    for (std::size_t i = 0; i < mesh.points.size(); ++i)
+      mesh.points[i] += Point<Dim>::Constant(1e-3 * std::sin(static_cast<double>(i)));
+    const std::string bin = msh_string(mesh, MshEncoding::Binary);
+    CHECK(bin.rfind("$MeshFormat\n4.1 1 8\n", 0) == 0);
+    const Mesh<Dim> back = parse_msh<Dim>(bin);
+    check_same(mesh, back);
+    CHECK(msh_string(back, MshEncoding::Binary) == bin);
+    CHECK(msh_string(back) == msh_string(mesh));  // the ASCII text of the same mesh
+  }
+}
+
+TEST_CASE("binary MSH of mixed element types and the writer's file", "[msh]") {
+  Mesh<3> m;
+  using P = Point<3>;
+  for (const P& p : {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0.5, 0.5, 1), P(0.5, 0.5, -1)}) m.add_point(p);
+  m.solid.add(ElemType::Pyramid5, {VertexId{0}, VertexId{1}, VertexId{2}, VertexId{3}, VertexId{4}});
+  m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{2}, VertexId{1}, VertexId{5}});
+  m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{3}, VertexId{2}, VertexId{5}});
+  test::set_interface_to_boundary(m);
+  const fs::path file = temp_dir() / "mixed-binary.msh";
+  write_msh(m, file, MshEncoding::Binary);
+  CHECK(slurp(file) == msh_string(m, MshEncoding::Binary));
+  check_same(m, read_msh<3>(file));
+  fs::remove(file);
+}
+
+TEST_CASE("binary MSH reader rejects truncated data with a message", "[msh]") {
+  const std::string bin = msh_string(two_triangles(), MshEncoding::Binary);
+  const std::size_t nodes = bin.find("$Nodes\n");
+  REQUIRE(nodes != std::string::npos);
+  for (const std::size_t cut : {nodes + 10, nodes + 40, bin.find("$Elements\n") + 30}) {
+    CHECK_THROWS_AS(parse_msh<2>(std::string_view(bin).substr(0, cut)), InputError);
+  }
+  std::string swapped = bin;
+  const std::size_t one = swapped.find("4.1 1 8\n") + 8;
+  swapped[one] = 0, swapped[one + 3] = 1;  // the byte-order mark of the other endianness
+  CHECK_THROWS_AS(parse_msh<2>(swapped), InputError);
+}
+
+TEMPLATE_TEST_CASE_SIG("gmsh reads our binary MSH file and writes binary we read back", "[msh][gmsh]", ((int Dim), Dim), 2, 3) {
+  if (!fs::exists("/usr/bin/gmsh")) {
+    WARN("gmsh is not installed: skipping");
+    return;
+  }
+  const Mesh<Dim> mesh = test::grid_mesh<Dim>(2, true, 0.5);
+  const fs::path dir = temp_dir();
+  const fs::path in = dir / ("bin-in" + std::to_string(Dim) + ".msh"), out = dir / ("bin-out" + std::to_string(Dim) + ".msh");
+  const fs::path log = dir / "gmsh-bin.log";
+  write_msh(mesh, in, MshEncoding::Binary);
+  const std::string cmd = "/usr/bin/gmsh " + in.string() + " -save -bin -format msh41 -o " + out.string() + " > " +
+                          log.string() + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  INFO(slurp(log));
+  REQUIRE(rc == 0);
+  CHECK(slurp(log).find("Error") == std::string::npos);
+  CHECK(slurp(out).rfind("$MeshFormat\n4.1 1 8\n", 0) == 0);  // Gmsh wrote binary
+  const Mesh<Dim> back = read_msh<Dim>(out);
+  CHECK(back.points.size() == mesh.points.size());
+  CHECK(back.solid.size() == mesh.solid.size());
+  CHECK(back.interface.size() == mesh.interface.size());
+  CHECK(is_valid(back));
+  fs::remove_all(dir);
+}
