@@ -144,12 +144,15 @@ struct Summary {
 /// Plot: mean over runs of the smallest angle, 5th percentile and boundary-quadrant smallest
 /// angle against F (top), and the element count relative to F = 0 (bottom), both variants.
 void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path& file) {
-  SvgCanvas svg(760.0, 40.0);
-  svg.set_view(Box<2>{P2(-0.18, -1.25), P2(1.45, 1.12)});
+  SvgCanvas svg(900.0, 40.0);
+  svg.set_view(Box<2>{P2(-0.18, -1.25), P2(1.75, 1.12)});
   const SvgStyle axis{"none", "black", 1.0, 1.0};
   // Top panel: angles in [0, 45] -> y in [0, 1]; bottom: ratio in [0.8, 1.2] -> y in [-1.1, -0.3].
   auto top = [](double f, double deg) { return P2(f * 2.0, deg / 45.0); };
-  auto bottom = [](double f, double ratio) { return P2(f * 2.0, -1.1 + (ratio - 0.8) / 0.4 * 0.8); };
+  double rmax = 1.2;
+  for (const auto& [key, s] : sums) rmax = std::max(rmax, s.elements_ratio);
+  rmax = std::ceil(rmax * 5.0) / 5.0;
+  auto bottom = [rmax](double f, double ratio) { return P2(f * 2.0, -1.1 + (ratio - 0.8) / (rmax - 0.8) * 0.8); };
   svg.line(P2(0, 0), P2(1.0, 0), axis);
   svg.line(P2(0, 0), P2(0, 1.0), axis);
   svg.line(P2(0, -1.1), P2(1.0, -1.1), axis);
@@ -163,7 +166,7 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
     svg.line(top(0, d), top(-0.01, d), axis);
     svg.text(top(-0.07, d) + P2(0, -0.01), std::to_string(d), 11.0);
   }
-  for (double q : {0.8, 1.0, 1.2}) svg.text(bottom(-0.09, q) + P2(0, -0.01), fmt("%.1f", q), 11.0);
+  for (double q : {0.8, 1.0, rmax}) svg.text(bottom(-0.09, q) + P2(0, -0.01), fmt("%.1f", q), 11.0);
   svg.line(bottom(0, 1.0), bottom(0.5, 1.0), SvgStyle{"none", "#bbbbbb", 0.8, 1.0});
   svg.line(top(0.35, 0), top(0.35, 45), SvgStyle{"none", "#bbbbbb", 0.8, 1.0});
   svg.text(top(0.355, 43), "default 0.35", 11.0, "#777777");
@@ -182,7 +185,7 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
     for (const Curve& cv : curves) {
       std::vector<P2> pts;
       for (const auto& [key, s] : sums)
-        if (key.first == qp && s.valid > 0) pts.push_back(top(key.second, s.*cv.field));
+        if (key.first == qp) pts.push_back(top(key.second, s.*cv.field));
       svg.polyline(pts, SvgStyle{"none", c, cv.width, 1.0});
       for (const P2& p : pts) svg.dot(p, cv.width + 1.0, SvgStyle{c, "none", 0.0, 1.0});
       svg.text(P2(1.05, 1.0 - 0.07 * (colour * 4 + k)), (qp ? "quality pass: " : "paper only: ") + cv.label, 11.0, c);
@@ -190,15 +193,15 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
     }
     std::vector<P2> pts;
     for (const auto& [key, s] : sums)
-      if (key.first == qp && s.valid > 0) pts.push_back(bottom(key.second, s.elements_ratio));
+      if (key.first == qp) pts.push_back(bottom(key.second, s.elements_ratio));
     svg.polyline(pts, SvgStyle{"none", c, 2.0, 1.0});
     for (const P2& p : pts) svg.dot(p, 3.0, SvgStyle{c, "none", 0.0, 1.0});
     svg.text(P2(1.05, -0.35 - 0.07 * colour), (qp ? "quality pass" : "paper only"), 11.0, c);
     ++colour;
   }
-  svg.text(P2(0.0, 1.06), "Buffer fraction F vs smallest angles (degrees, mean over the inputs and levels meshed at every F)", 14.0);
-  svg.text(P2(0.0, -0.24), "Element count relative to F = 0 (mean over the inputs and levels meshed at every F)", 14.0);
-  svg.text(P2(0.75, -1.23), "buffer fraction F", 12.0);
+  svg.text(P2(0.0, 1.06), "Smallest angles (degrees) against the buffer fraction F", 14.0);
+  svg.text(P2(0.0, -0.24), "Element count relative to F = 0", 14.0);
+  svg.text(P2(0.75, -1.23), "buffer fraction F (means over the inputs and levels meshed at every F)", 12.0);
   svg.write(file);
 }
 
@@ -266,8 +269,8 @@ int main(int argc, char** argv) {
     ++s.runs;
     if (!r.ok) continue;
     ++s.ok;
-    if (!complete[{r.input, r.level}]) continue;
     s.valid += r.valid;
+    if (!complete[{r.input, r.level}]) continue;
     s.thin += r.n_thin;
     s.min_angle = std::min(s.min_angle, r.min_angle);
     s.thinnest = std::min(s.thinnest, r.thinnest);
