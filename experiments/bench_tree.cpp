@@ -61,31 +61,15 @@ template <int Dim> ControlFn<Dim> sphere_control(double r, int k) {
   };
 }
 
-/// Resident set size now (VmRSS), in bytes.
-double resident_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kb = 0;
-      status >> kb;
-      return kb * 1024.0;
-    }
-    std::getline(status, key);
-  }
-  return 0.0;
-}
-
 /// Memory cost of one operation: the growth of the peak resident set while it runs, from the
-/// resident set just before it (Linux: writing 5 to clear_refs resets the high-water mark).
-/// Free heap memory is returned to the system first, or the operation could reuse pages that
-/// are already counted in the base.
+/// resident set just before it (the peak is reset first). Free heap memory is returned to the
+/// system first, or the operation could reuse pages that are already counted in the base.
 class PeakDelta {
  public:
   PeakDelta() {
     malloc_trim(0);
-    std::ofstream("/proc/self/clear_refs") << "5";
-    base_ = resident_bytes();
+    if (!reset_peak_memory()) std::cerr << "cannot reset the peak resident set; B/leaf is an upper bound\n";
+    base_ = double(current_memory_bytes());
   }
   double bytes() const { return double(peak_memory_bytes()) - base_; }
 
