@@ -370,11 +370,11 @@ rc::Gen<Pose> gen_pose() {
   });
 }
 
-rc::Gen<SurfaceSpec> gen_sphere_spec() {
-  return rc::gen::exec([] {
+rc::Gen<SurfaceSpec> gen_sphere_spec(int min_subdivisions) {
+  return rc::gen::exec([min_subdivisions] {
     SurfaceSpec s;
     s.kind = ShapeKind::Sphere;
-    s.subdivisions = *rc::gen::inRange(1, 3);
+    s.subdivisions = min_subdivisions >= 2 ? min_subdivisions : *rc::gen::inRange(1, 3);
     for (int& h : s.harmonics) h = signed_small(3);
     s.pose = *gen_pose();
     return s;

@@ -77,7 +77,9 @@ std::string to_off(const SurfaceSpec& spec);
 std::string describe(const SurfaceSpec& spec);
 
 rc::Gen<Pose> gen_pose();
-rc::Gen<SurfaceSpec> gen_sphere_spec();
+/// Icospheres of 1 or 2 subdivisions (80 / 320 triangles), or exactly `min_subdivisions` when
+/// it is 2 or more (the coarse ones have sharper edges: see test_pipeline3d_properties.cpp).
+rc::Gen<SurfaceSpec> gen_sphere_spec(int min_subdivisions = 1);
 rc::Gen<SurfaceSpec> gen_torus_spec();
 rc::Gen<SurfaceSpec> gen_voxel_spec();
 /// One of the three kinds (sphere first: shrinking moves towards it).
