@@ -366,7 +366,10 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         } else if (opt.corners_may_fail) {
           ++res.stats.n_corners_missed;
         } else {
-          res.problems.push_back({corners[ci].point, "two corners between the same two boundary nodes"});
+          // Reported at the chain nodes: the repair refines around a place by the size of the leaf
+          // there, and the corner may sit in a tiny outside leaf.
+          for (std::size_t j : {k, kn})
+            res.problems.push_back({qc.points[ch.q[j]], "two corners between the same two boundary nodes"});
         }
       }
     }

@@ -569,10 +569,10 @@ void CurveBoundary::compute_automatic_levels() {
       for (int j = 0; j < 8; ++j) {
         const P2 s = bezier_point(q, (j + 0.5) / 8.0);
         const double feature = feature_thickness(s, int(i), int(k));
-        if (std::isfinite(feature)) feature_lv = std::max(feature_lv, level_for(0.5 * feature));
+        if (std::isfinite(feature)) feature_lv = std::max(feature_lv, level_for(feature / quadrants_across_feature));
         if (!automatic) continue;
         const double thick = local_thickness(s);
-        if (std::isfinite(thick)) thick_lv = std::max(thick_lv, level_for(0.5 * thick));
+        if (std::isfinite(thick)) thick_lv = std::max(thick_lv, level_for(thick / quadrants_across_feature));
       }
       thickness_level_[i][k] = feature_lv;
       if (!automatic) continue;

@@ -103,6 +103,11 @@ class CurveBoundary final : public Boundary<2> {
   /// Slow twin of classify: same answer from brute force over all pieces, no BVH.
   Side classify_ref(const Box<2>& box) const;
 
+  /// Quadrants across the thinnest feature. With the buffer rule (0.35 of a size on each side)
+  /// and an arbitrary lattice offset, a straight stroke of width w holds an edge-connected row of
+  /// interior quadrants of size s only when w >= 2.7 s, and a diagonal one when w >= ~3.5 s.
+  static constexpr double quadrants_across_feature = 4.0;
+
  private:
   struct Piece {
     Bezier q;

@@ -10,13 +10,16 @@
 
 namespace febemesh::dim2 {
 
-double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
-                                         std::size_t* n_exempt) {
-  std::vector<P2> sharp;
+AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve,
+                                                     double sharp_deg) {
+  // Exempt radius in element sizes: 8, or the distance from the tip at which the corner's
+  // wedge is 4 element sizes wide (w = 2 r tan(a/2)), whichever is larger; inside it the
+  // wedge, not the mesher, sets the angles.
+  std::vector<std::pair<P2, double>> sharp;
   for (const CurveCorner& c : curve.corners())
-    if (c.angle_deg < sharp_deg) sharp.push_back(c.point);
-  double best = 180.0;
-  std::size_t exempt = 0;
+    if (c.angle_deg < sharp_deg)
+      sharp.emplace_back(c.point, std::max(8.0, 2.0 / std::tan(0.5 * std::max(c.angle_deg, 1e-3) * M_PI / 180.0)));
+  AnglesAwayFromCorners out;
   for (std::size_t e = 0; e < m.solid.size(); ++e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     const int n = m.solid.n_nodes_of(id);
@@ -24,16 +27,36 @@ double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& 
     double size = 0.0;
     for (int k = 0; k < n; ++k) size = std::max(size, (m.points[v[k].v] - m.points[v[(k + 1) % n].v]).norm());
     bool near = false;
-    for (const P2& c : sharp)
-      for (int k = 0; k < n && !near; ++k) near = (m.points[v[k].v] - c).norm() <= 8.0 * size;
+    for (const auto& [c, radius] : sharp)
+      for (int k = 0; k < n && !near; ++k) near = (m.points[v[k].v] - c).norm() <= radius * size;
     if (near) {
-      ++exempt;
+      ++out.n_exempt;
       continue;
     }
-    best = std::min(best, min_corner_angle_deg(m, e));
+    double lo = 180.0, hi = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const P2 a = m.points[v[(k + n - 1) % n].v] - m.points[v[k].v], b = m.points[v[(k + 1) % n].v] - m.points[v[k].v];
+      const double cr = b[0] * a[1] - b[1] * a[0];
+      // A reflex or inverted corner counts as 0 deg (the worst) for both bounds.
+      const double ang = cr > 0 ? std::atan2(cr, a.dot(b)) * 180.0 / M_PI : 0.0;
+      lo = std::min(lo, ang);
+      hi = std::max(hi, cr > 0 ? ang : 180.0);
+    }
+    if (n == 3) {
+      out.min_triangle_deg = std::min(out.min_triangle_deg, lo);
+    } else {
+      out.min_quad_deg = std::min(out.min_quad_deg, lo);
+      out.max_quad_deg = std::max(out.max_quad_deg, hi);
+    }
   }
-  if (n_exempt) *n_exempt = exempt;
-  return best;
+  return out;
+}
+
+double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
+                                         std::size_t* n_exempt) {
+  const AnglesAwayFromCorners a = angles_away_from_sharp_corners(m, curve, sharp_deg);
+  if (n_exempt) *n_exempt = a.n_exempt;
+  return std::min(a.min_triangle_deg, a.min_quad_deg);
 }
 
 Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int samples) {

@@ -19,12 +19,24 @@ struct Fidelity2d {
   double max_node_distance_rel = 0.0;
 };
 
-/// Smallest corner angle (degrees) over the FE elements that lie farther than eight of their own
-/// sizes from every input corner sharper than `sharp_deg` (the quality bar exempts those
-/// corners: no element there can beat the corner's own angle). Also returns how many elements
-/// were exempt through `n_exempt`.
+/// Smallest corner angle (degrees) over the FE elements that lie away from every input corner
+/// sharper than `sharp_deg` (the quality bar exempts those corners: no element there can beat
+/// the corner's own angle). "Away" = farther than max(8, 2 / tan(angle / 2)) of the element's
+/// own sizes: 8 sizes, or the part of the corner's wedge thinner than 4 element sizes. Also
+/// returns how many elements were exempt through `n_exempt`.
 double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
                                          std::size_t* n_exempt = nullptr);
+
+/// Corner angles (degrees) over the elements away from sharp corners, as above, by kind: the
+/// triangles' smallest angle and the quads' smallest and largest (the bars are >= 20 deg for
+/// triangles and [30, 150] deg for quads). 180 / 0 when there is no such element.
+struct AnglesAwayFromCorners {
+  double min_triangle_deg = 180.0;
+  double min_quad_deg = 180.0;
+  double max_quad_deg = 0.0;
+  std::size_t n_exempt = 0;
+};
+AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg);
 
 /// `samples` curve points per BE edge for the Hausdorff estimate (one-sided from the curve,
 /// which dominates: the BE edges are chords of the curve).

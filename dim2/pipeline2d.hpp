@@ -29,12 +29,16 @@ struct Options2d {
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
-  int n_threads = 1;
+  int n_threads = 1;                 ///< threads for refinement and classification; results do not depend on it
   bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures
+  /// Stages are dropped (and the unpulled complex is not rebuilt) when the mesh has more FE
+  /// elements than this: figures of 10^5 quadrants are unreadable and cost more than meshing.
+  std::size_t keep_stages_max_elements = static_cast<std::size_t>(-1);
 };
 
 struct Result2d {
-  // Stages, kept when Options2d::keep_stages (the paper's Figures 3-12).
+  // Stages, kept when Options2d::keep_stages and the mesh is small enough (stages_kept).
+  bool stages_kept = false;
   Orthtree<2> subdivided;           ///< after check_and_subdivide_quadrant
   Orthtree<2> balanced;             ///< after the one-level-difference rule
   Orthtree<2> tree;                 ///< final tree (after repairs)
@@ -50,6 +54,7 @@ struct Result2d {
   std::vector<Problem> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_rejected = 0;
   std::size_t n_flips = 0;          ///< edge flips of the quality pass
+  std::size_t n_angle_moves = 0;    ///< node moves of the corner-angle optimisation (quad, mixed)
   std::vector<StageTime> times;
 };
 

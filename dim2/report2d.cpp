@@ -61,6 +61,11 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   std::size_t n_exempt = 0;
   quality["min_angle_away_from_sharp_corners_deg"] = min_angle_away_from_sharp_corners(m, curve, 20.0, &n_exempt);
   quality["elements_near_sharp_corners"] = n_exempt;
+  if (n_quad > 0) {
+    // The quad bar, [30, 150] deg, away from input corners sharper than 30 deg.
+    const AnglesAwayFromCorners a = angles_away_from_sharp_corners(m, curve, 30.0);
+    quality["quad_angle_range_away_from_sharp_corners_deg"] = {a.min_quad_deg, a.max_quad_deg};
+  }
   quality["min_scaled_jacobian"] = q.min_scaled_jacobian;
   quality["mean_scaled_jacobian"] = q.mean_scaled_jacobian;
   quality["max_aspect_ratio"] = q.max_aspect_ratio;

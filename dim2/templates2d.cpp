@@ -122,8 +122,24 @@ void boundary_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind)
   }
 }
 
-/// Split every element once: triangle -> 3 quads, quad -> 4 quads (conforming through shared
-/// edge midpoints; curve edges get their midpoint on the curve).
+}  // namespace
+
+const char* name(ElementKind k) {
+  switch (k) {
+    case ElementKind::Tri: return "tri";
+    case ElementKind::Quad: return "quad";
+    case ElementKind::Mixed: return "mixed";
+  }
+  return "?";
+}
+
+ElementKind element_kind_from(const std::string& s) {
+  if (s == "tri") return ElementKind::Tri;
+  if (s == "quad") return ElementKind::Quad;
+  if (s == "mixed") return ElementKind::Mixed;
+  throw std::invalid_argument("element kind must be tri, quad or mixed, got '" + s + "'");
+}
+
 FeBeMesh split_to_quads(const FeBeMesh& in, const CurveMidpoint& midpoint) {
   Builder b;
   b.out.mesh.points = in.mesh.points;
@@ -167,24 +183,6 @@ FeBeMesh split_to_quads(const FeBeMesh& in, const CurveMidpoint& midpoint) {
     b.out.mesh.interface.add(ElemType::Line2, {vid(m), v[1]});
   }
   return std::move(b.out);
-}
-
-}  // namespace
-
-const char* name(ElementKind k) {
-  switch (k) {
-    case ElementKind::Tri: return "tri";
-    case ElementKind::Quad: return "quad";
-    case ElementKind::Mixed: return "mixed";
-  }
-  return "?";
-}
-
-ElementKind element_kind_from(const std::string& s) {
-  if (s == "tri") return ElementKind::Tri;
-  if (s == "quad") return ElementKind::Quad;
-  if (s == "mixed") return ElementKind::Mixed;
-  throw std::invalid_argument("element kind must be tri, quad or mixed, got '" + s + "'");
 }
 
 FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint) {

@@ -39,6 +39,12 @@ struct FeBeMesh {
 };
 
 /// Triangles / quads / mixed elements of every quadrant, and the BE edges, sharing nodes.
+/// Quad = the mixed mesh split once (split_to_quads).
 FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint);
+
+/// All quadrilaterals: every element split once through its centroid and edge midpoints
+/// (triangle -> 3 quads, quad -> 4), conforming because neighbours share the edge midpoints;
+/// the midpoints of BE edges lie on the curve (`midpoint`), each BE edge becomes two.
+FeBeMesh split_to_quads(const FeBeMesh& in, const CurveMidpoint& midpoint);
 
 }  // namespace febemesh::dim2

@@ -172,8 +172,9 @@ TEST_CASE("segments: crossing, touching, and projection segments", "[boundary]")
 }
 
 TEST_CASE("control levels: explicit, interpolated, interior, global and automatic", "[boundary]") {
-  // Explicit levels at two corners of a square, interpolated along the edges.
-  std::vector<ControlPoint> cps{{P2(0, 0), true, 2.0}, {P2(4, 0), true, 6.0}, {P2(4, 4), true, no_level},
+  // Explicit levels at two corners of a square, interpolated along the edges. (Level 3 at
+  // least: the thickness rule puts 4 quadrants across the square, about level 2.6 here.)
+  std::vector<ControlPoint> cps{{P2(0, 0), true, 3.0}, {P2(4, 0), true, 6.0}, {P2(4, 4), true, no_level},
                                 {P2(0, 4), true, no_level}};
   Domain d;
   d.source = "levels";
@@ -184,13 +185,13 @@ TEST_CASE("control levels: explicit, interpolated, interior, global and automati
     CHECK(b.control_level(Box<2>{P2(1.9, 1.9), P2(2.1, 2.1)}) == 0.0);          // away from the curve
     // Linear in the parameter: near a tripled corner the speed vanishes, so a small box spans a
     // longer parameter range (u ~ (distance / 0.67)^(1/3) on the corner's first piece).
-    CHECK(b.control_level(Box<2>{P2(-0.001, -0.001), P2(0.001, 0.001)}) == Approx(2.0).margin(0.2));
+    CHECK(b.control_level(Box<2>{P2(-0.001, -0.001), P2(0.001, 0.001)}) == Approx(3.0).margin(0.2));
     CHECK(b.control_level(Box<2>{P2(3.999, -0.001), P2(4.001, 0.001)}) == Approx(6.0).margin(0.2));
-    CHECK(b.control_level(Box<2>{P2(-0.1, -0.1), P2(0.1, 0.1)}) < 3.0);
+    CHECK(b.control_level(Box<2>{P2(-0.1, -0.1), P2(0.1, 0.1)}) < 4.0);
     const double mid = b.control_level(Box<2>{P2(1.9, -0.1), P2(2.1, 0.1)});
-    CHECK(mid > 2.0);
+    CHECK(mid > 3.0);
     CHECK(mid < 6.0);
-    CHECK(b.level_at(0, 1.0) == 2.0);
+    CHECK(b.level_at(0, 1.0) == 3.0);
   }
   d.interior.push_back(InteriorControl{P2(2, 2), 7.0, 0.5});
   {
@@ -220,7 +221,7 @@ TEST_CASE("control levels: explicit, interpolated, interior, global and automati
   t.loops.push_back(loop_from_polygon({P2(0, 0), P2(10, 0), P2(10, 0.1), P2(0, 0.1)}, "thin"));
   CurveBoundary tb(t);
   const double thin = tb.control_level(Box<2>{P2(4.9, -0.01), P2(5.1, 0.01)});
-  CHECK(tb.root_box().extent().x() / std::pow(2.0, thin) <= 0.05 * 1.0001);
+  CHECK(tb.root_box().extent().x() / std::pow(2.0, thin) <= 0.1 / CurveBoundary::quadrants_across_feature * 1.0001);
   tb.set_max_level(4);
   CHECK(tb.control_level(Box<2>{P2(4.9, -0.01), P2(5.1, 0.01)}) == 4.0);
 }

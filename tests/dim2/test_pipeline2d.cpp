@@ -25,6 +25,7 @@ struct Run {
   ValidationReport v;
   Fidelity2d f;
   double min_angle_bar = 0.0;  ///< min angle away from sharp input corners
+  AnglesAwayFromCorners quad_bar;  ///< quad angles away from corners sharper than 30 deg
 };
 
 Run run(const std::string& path, double level, ElementKind kind) {
@@ -34,7 +35,7 @@ Run run(const std::string& path, double level, ElementKind kind) {
   opt.level = level;
   opt.elements = kind;
   opt.keep_stages = false;
-  Run out{mesh2d(curve, opt), {}, {}, 0.0};
+  Run out{mesh2d(curve, opt), {}, {}, 0.0, {}};
   ValidateOptions<2> vo;
   vo.expected_euler = curve.n_components() - curve.n_holes();
   const Box<2> bb = curve.bounding_box();
@@ -43,6 +44,7 @@ Run run(const std::string& path, double level, ElementKind kind) {
   out.v = validate<2>(out.r.fe.mesh, vo);
   out.f = measure_fidelity(out.r.fe, curve);
   out.min_angle_bar = min_angle_away_from_sharp_corners(out.r.fe.mesh, curve, 20.0);
+  out.quad_bar = angles_away_from_sharp_corners(out.r.fe.mesh, curve, 30.0);
   return out;
 }
 
@@ -64,8 +66,10 @@ TEST_CASE("mesh2d gives valid FE and BE meshes on the bundled examples", "[pipel
     }
   for (ElementKind kind : {ElementKind::Tri, ElementKind::Mixed})
     for (double level : {6.0, 7.0, 8.0}) cases.push_back({"naca0012.json", kind, level});
-  // Quad mode: known to invert elements on the bracket's curve-edge splits (see the issue notes).
-  for (double level : {5.0, 6.0, 7.0}) cases.push_back({"flange.json", ElementKind::Quad, level});
+  for (double level : {5.0, 6.0, 7.0}) {
+    cases.push_back({"bracket.json", ElementKind::Quad, level});
+    cases.push_back({"flange.json", ElementKind::Quad, level});
+  }
   for (const Case& c : cases) {
     INFO(c.file << " " << name(c.kind) << " level " << c.level);
     const Run out = run(example(c.file), c.level, c.kind);
@@ -79,6 +83,12 @@ TEST_CASE("mesh2d gives valid FE and BE meshes on the bundled examples", "[pipel
     // The quality bar (issue 4): triangles >= 20 deg away from input corners sharper than 20
     // deg; mixed meshes too (their triangles come from the same templates).
     if (c.kind != ElementKind::Quad) CHECK(out.min_angle_bar >= 20.0);
+    // Quads (quad and mixed): corner angles within [30, 150] deg away from corners sharper
+    // than 30 deg (bracket and flange have none).
+    if (c.kind != ElementKind::Tri) {
+      CHECK(out.quad_bar.min_quad_deg >= 30.0);
+      CHECK(out.quad_bar.max_quad_deg <= 150.0);
+    }
   }
 }
 

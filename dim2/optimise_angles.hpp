@@ -1,0 +1,41 @@
+#pragma once
+// Beyond the paper: a local search on node positions that raises the worst corner angle of a
+// 2D mesh of triangles and quadrilaterals, measured against each kind's bar:
+//   triangle  q = smallest angle / 20 deg
+//   quad      q = min over corners of min(angle, 180 - angle) / 30 deg   (the [30, 150] bar)
+// so q >= 1 means the element meets its bar. Laplacian smoothing and the triangle quality pass
+// (improve2d) move a node toward the centroid of its neighbours; that is not enough for quads,
+// whose largest angle matters as much as the smallest, nor for the quads made by splitting
+// triangles (whose corner angles start as the triangle's). Here each node whose elements are
+// below `target` tries the centroid of its neighbours and small pattern steps around its
+// position, and keeps the best candidate only if the worst q of its elements rises. No element
+// ever inverts (an inverted or reflex corner gives q < 0, which is never accepted).
+// Deterministic: nodes are visited in index order, candidates in a fixed order.
+#include <cstdint>
+#include <vector>
+
+#include "core/mesh.hpp"
+#include "dim2/improve2d.hpp"
+
+namespace febemesh::dim2 {
+
+/// Worst corner angle of element e measured against its kind's bar (see above); < 0 when a
+/// corner is reflex or the element is inverted.
+double angle_quality(const Mesh<2>& m, std::size_t e);
+
+struct AngleOptimiseOptions {
+  int rounds = 8;         ///< sweeps over the nodes
+  double target = 1.25;   ///< nodes whose elements all reach this q are left alone
+};
+
+struct AngleOptimiseStats {
+  std::size_t moves = 0;
+  double worst_before = 0.0;  ///< smallest q over the mesh
+  double worst_after = 0.0;
+};
+
+/// `locked` as in improve_mesh: 0 free, 1 fixed, 2 interface node that slides through `slide`.
+AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& locked,
+                                   const AngleOptimiseOptions& opt = {}, const SlideFn& slide = {});
+
+}  // namespace febemesh::dim2

@@ -1,0 +1,149 @@
+// The corner-angle optimiser (dim2/optimise_angles): it raises the worst angle quality, never
+// inverts an element, leaves locked nodes where they are and keeps sliding nodes on the curve.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "core/validate.hpp"
+#include "dim2/optimise_angles.hpp"
+#include "property.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim2;
+
+namespace {
+
+/// An n x n grid of unit quads on [0, n]^2, every interior node displaced by (dx, dy)(node).
+template <class Disp>
+Mesh<2> grid(int n, Disp disp) {
+  Mesh<2> m;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      Point<2> p(i, j);
+      if (i > 0 && j > 0 && i < n && j < n) p += disp(i, j);
+      m.add_point(p);
+    }
+  auto id = [&](int i, int j) { return VertexId{j * (n + 1) + i}; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      m.solid.add(ElemType::Quad4, {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+      m.level.push_back(0);
+      m.from_boundary_cell.push_back(0);
+    }
+  return m;
+}
+
+double worst(const Mesh<2>& m) {
+  double q = 1e300;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) q = std::min(q, angle_quality(m, e));
+  return q;
+}
+
+std::vector<std::uint8_t> lock_border(const Mesh<2>& m, int n) {
+  std::vector<std::uint8_t> locked(m.points.size(), 0);
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    const double x = m.points[v][0], y = m.points[v][1];
+    if (x == 0 || y == 0 || x == n || y == n) locked[v] = 1;
+  }
+  return locked;
+}
+
+}  // namespace
+
+TEST_CASE("angle quality measures triangles against 20 deg and quads against [30, 150]", "[optimise_angles]") {
+  Mesh<2> m;
+  m.add_point(Point<2>(0, 0));
+  m.add_point(Point<2>(1, 0));
+  m.add_point(Point<2>(1, 1));
+  m.add_point(Point<2>(0, 1));
+  m.solid.add(ElemType::Quad4, {VertexId{0}, VertexId{1}, VertexId{2}, VertexId{3}});
+  m.solid.add(ElemType::Tri3, {VertexId{0}, VertexId{1}, VertexId{2}});
+  CHECK(angle_quality(m, 0) == Approx(90.0 / 30.0));
+  CHECK(angle_quality(m, 1) == Approx(45.0 / 20.0));
+  m.points[2] = Point<2>(2, 1);  // quad angles 45, 135: 45/30
+  CHECK(angle_quality(m, 0) == Approx(45.0 / 30.0));
+  m.points[2] = Point<2>(0.2, 0.2);  // reflex corner at node 2
+  CHECK(angle_quality(m, 0) < 0);
+}
+
+TEST_CASE("a badly placed interior node is moved until every quad is within [30, 150]", "[optimise_angles]") {
+  const int n = 3;
+  // Two interior nodes pushed far off: angles near 20 and 160 degrees.
+  Mesh<2> m = grid(n, [](int i, int j) { return Point<2>(i == 1 && j == 1 ? 0.6 : 0.0, j == 2 && i == 2 ? -0.6 : 0.0); });
+  const Mesh<2> before = m;
+  const double q0 = worst(m);
+  REQUIRE(q0 > 0);
+  REQUIRE(q0 < 1.0);
+  const std::vector<std::uint8_t> locked = lock_border(m, n);
+  const AngleOptimiseStats st = optimise_angles(m, locked);
+  CHECK(st.moves > 0);
+  CHECK(st.worst_before == Approx(q0));
+  CHECK(st.worst_after == Approx(worst(m)));
+  CHECK(worst(m) >= 1.0);
+  CHECK(validate<2>(m).inverted == 0);
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    if (locked[v]) CHECK(m.points[v] == before.points[v]);
+}
+
+TEST_CASE("sliding nodes stay on the curve", "[optimise_angles]") {
+  // A ring of quads between radii 1 and 2; outer nodes slide on the circle of radius 2 and start
+  // bunched up, so spreading them along the circle is what improves the quads.
+  const int k = 16;
+  Mesh<2> m;
+  for (int i = 0; i < k; ++i) {
+    const double a = 2 * M_PI * i / k;
+    const double b = a + (i % 2 ? 0.6 : -0.6) * (M_PI / k);  // outer nodes out of step
+    m.add_point(Point<2>(std::cos(a), std::sin(a)));
+    m.add_point(Point<2>(2 * std::cos(b), 2 * std::sin(b)));
+  }
+  for (int i = 0; i < k; ++i) {
+    const int j = (i + 1) % k;
+    m.solid.add(ElemType::Quad4, {VertexId{2 * i}, VertexId{2 * i + 1}, VertexId{2 * j + 1}, VertexId{2 * j}});
+    m.level.push_back(0);
+    m.from_boundary_cell.push_back(0);
+  }
+  // The ring runs clockwise this way round: reverse to CCW if needed.
+  if (angle_quality(m, 0) < 0) {
+    Mesh<2> r;
+    r.points = m.points;
+    for (int i = 0; i < k; ++i) {
+      const int j = (i + 1) % k;
+      r.solid.add(ElemType::Quad4, {VertexId{2 * i}, VertexId{2 * j}, VertexId{2 * j + 1}, VertexId{2 * i + 1}});
+      r.level.push_back(0);
+      r.from_boundary_cell.push_back(0);
+    }
+    m = r;
+  }
+  REQUIRE(worst(m) > 0);
+  std::vector<std::uint8_t> locked(m.points.size());
+  for (std::size_t v = 0; v < locked.size(); ++v) locked[v] = v % 2 ? 2 : 1;
+  const SlideFn on_circle = [](std::int32_t, const Point<2>& p) { return Point<2>(2.0 * p.normalized()); };
+  const double q0 = worst(m);
+  AngleOptimiseOptions ao;
+  ao.target = 3.0;  // above the start (about 2.2): optimise every node
+  optimise_angles(m, locked, ao, on_circle);
+  CHECK(worst(m) > q0);
+  for (std::size_t v = 1; v < m.points.size(); v += 2) CHECK(std::abs(m.points[v].norm() - 2.0) < 1e-12);
+  for (std::size_t v = 0; v < m.points.size(); v += 2) CHECK(std::abs(m.points[v].norm() - 1.0) < 1e-12);
+}
+
+TEST_CASE("the optimiser never inverts an element nor lowers the worst quality", "[optimise_angles][property]") {
+  febemesh::test::prop("random jiggled grids", 100, [] {
+    const int n = *rc::gen::inRange(2, 6);
+    const auto jiggle = *rc::gen::container<std::vector<int>>(2 * (n + 1) * (n + 1), rc::gen::inRange(-45, 46));
+    Mesh<2> m = grid(n, [&](int i, int j) {
+      const std::size_t k = 2 * std::size_t(j * (n + 1) + i);
+      return Point<2>(jiggle[k] / 100.0, jiggle[k + 1] / 100.0);
+    });
+    const double q0 = worst(m);
+    RC_PRE(q0 > 0);
+    const Mesh<2> before = m;
+    optimise_angles(m, lock_border(m, n));
+    RC_ASSERT(worst(m) >= q0);
+    RC_ASSERT(validate<2>(m).inverted == 0u);
+    Mesh<2> again = before;  // deterministic
+    optimise_angles(again, lock_border(before, n));
+    RC_ASSERT(again.points == m.points);
+  });
+}
