@@ -7,6 +7,8 @@
 #include <iostream>
 #include <thread>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/args.hpp"
 #include "cli/command.hpp"
 #include "core/atomic_output.hpp"
@@ -45,15 +47,24 @@ options:
   --buffer F            drop interior quadrants nearer the curve than F x their size (default 0.35)
   --max-level N         finest level allowed, repairs included (default 16)
   --max-cells N         refuse trees larger than N quadrants (default 20000000)
-  --threads N           threads for subdivision and classification (default: all cores)
-  --no-figures          do not write figures/*.svg
+  --threads N           threads for refinement, classification and output (default: all cores);
+                        the mesh is the same byte for byte whatever N
+  --figures MODE        all | none | auto (default): auto draws the stage figures when the mesh
+                        has at most 20000 elements; above, only figures/00-geometry.svg and a
+                        figures/README.txt saying why (SVGs of 10^5 quadrants are unreadable,
+                        tens of MB, and took longer to write than the mesh)
+  --no-figures          same as --figures none
+  --binary              write mesh.msh as MSH 4.1 binary (smaller, faster to write and read)
   --no-validate         skip the final validation (benchmarks)
   --quiet               no progress on stderr
 
 outputs in DIR: mesh.msh (Gmsh MSH 4.1; physical groups "solid" and "interface"), mesh.vtu,
-report.json, figures/*.svg (one per stage of the paper).
+report.json, figures/*.svg (one per stage of the paper, see --figures).
 exit status: 0 success, 1 bad input, 2 bad usage.
 )";
+
+/// --figures auto: stage figures up to this many FE elements.
+constexpr std::size_t auto_figures_max_elements = 20000;
 
 /// Refuses a level whose mesh would exhaust memory, before building anything.
 void check_budget(const CurveBoundary& curve, double level, std::size_t max_cells) {
@@ -73,9 +84,9 @@ void check_budget(const CurveBoundary& curve, double level, std::size_t max_cell
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--slide", "--no-figures", "--no-validate", "--quiet"},
+  const Args args(argv, {"--slide", "--no-figures", "--no-validate", "--quiet", "--binary"},
                   {"-o", "--output", "--level", "--elements", "--smooth", "--buffer", "--max-level", "--max-cells",
-                   "--threads"});
+                   "--threads", "--figures"});
   args.expect_positional({"INPUT"});
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
@@ -91,7 +102,11 @@ int run(const std::vector<std::string>& argv) {
   opt.max_cells = static_cast<std::size_t>(args.real_or("--max-cells", 2e7, 1e2, 1e10));
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
-  opt.keep_stages = !args.has("--no-figures");
+  const std::string figures =
+      args.has("--no-figures") ? "none" : args.choice_or("--figures", "auto", {"all", "none", "auto"});
+  opt.keep_stages = figures != "none";
+  if (figures == "auto") opt.keep_stages_max_elements = auto_figures_max_elements;
+  const MshEncoding encoding = args.has("--binary") ? MshEncoding::Binary : MshEncoding::Ascii;
   const bool quiet = args.has("--quiet");
 
   const auto start = std::chrono::steady_clock::now();
@@ -123,12 +138,11 @@ int run(const std::vector<std::string>& argv) {
 
   progress("writing " + out);
   AtomicOutputDir dir(out);
-  write_msh<2>(r.fe.mesh, dir.file("mesh.msh"));
+  write_msh<2>(r.fe.mesh, dir.file("mesh.msh"), encoding);
   write_vtu<2>(r.fe.mesh, dir.file("mesh.vtu"));
-  if (opt.keep_stages) {
-    write_stage_figures(r, curve, dir.file("figures"));
-    draw_geometry_figure(curve, dir.file("figures") / "00-geometry.svg");
-  }
+  if (r.stages_kept) write_stage_figures(r, curve, dir.file("figures"));
+  else if (opt.keep_stages) write_figures_skipped_note(dir.file("figures"), r.fe.mesh.solid.size(), opt.keep_stages_max_elements);
+  if (opt.keep_stages) draw_geometry_figure(curve, dir.file("figures") / "00-geometry.svg");
   RunInfo info;
   info.input = input;
   info.version = FEBEMESH_VERSION;
@@ -136,7 +150,12 @@ int run(const std::vector<std::string>& argv) {
   info.peak_memory_bytes = peak_memory_bytes();
   {
     std::ofstream rep(dir.file("report.json"));
-    rep << report_json(r, curve, opt, fid, valid, info);
+    // The CLI's own options (figures, MSH encoding) join the library's in "options".
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(report_json(r, curve, opt, fid, valid, info));
+    j["options"]["figures"] = figures;
+    j["options"]["figures_drawn"] = r.stages_kept;
+    j["options"]["msh_encoding"] = encoding == MshEncoding::Binary ? "binary" : "ascii";
+    rep << j.dump(2) << "\n";
     if (!rep) throw InputError(dir.file("report.json").string() + ": cannot write");
   }
   dir.commit();

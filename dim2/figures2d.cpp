@@ -1,7 +1,9 @@
 #include "dim2/figures2d.hpp"
 
 #include <cstdio>
+#include <fstream>
 
+#include "core/error.hpp"
 #include "core/svg_canvas.hpp"
 #include "dim2/loop_geometry.hpp"
 
@@ -86,6 +88,16 @@ void draw_geometry_figure(const CurveBoundary& curve, const fs::path& file) {
   draw_corners(c, curve);
   caption(c, curve, "B-spline loops (blue), Bezier control points (grey), corners (red)");
   c.write(file);
+}
+
+void write_figures_skipped_note(const fs::path& dir, std::size_t n_elements, std::size_t limit) {
+  fs::create_directories(dir);
+  std::ofstream out(dir / "README.txt");
+  out << "The stage figures were not drawn: the mesh has " << n_elements << " elements, more than the "
+      << limit << " that an SVG of every quadrant shows legibly (and drawing them took longer than meshing).\n"
+      << "00-geometry.svg shows the input. Rerun with --figures all to draw them anyway, or view mesh.vtu in "
+         "ParaView.\n";
+  if (!out) throw InputError((dir / "README.txt").string() + ": cannot write");
 }
 
 std::vector<fs::path> write_stage_figures(const Result2d& r, const CurveBoundary& curve, const fs::path& dir) {

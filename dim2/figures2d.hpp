@@ -4,6 +4,7 @@
 // rule, interior quadrants, boundary quadrants, after corner pulling, after smoothing, boundary
 // elements, the final mesh).
 
+#include <cstddef>
 #include <filesystem>
 #include <vector>
 
@@ -15,6 +16,9 @@ namespace febemesh::dim2 {
 /// Writes the stage figures into `dir` (created); returns the file names written.
 std::vector<std::filesystem::path> write_stage_figures(const Result2d& r, const CurveBoundary& curve,
                                                        const std::filesystem::path& dir);
+
+/// figures/README.txt in `dir` (created) saying why the stage figures were not drawn.
+void write_figures_skipped_note(const std::filesystem::path& dir, std::size_t n_elements, std::size_t limit);
 
 /// The curve with its control polygon and corners (the paper's Figures 1-2).
 void draw_geometry_figure(const CurveBoundary& curve, const std::filesystem::path& file);

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 
 namespace febemesh::dim2 {
 namespace {
@@ -42,7 +43,198 @@ double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) {
   return polygon_min_angle(p.data(), n);
 }
 
+namespace {
+
+/// Node -> incident elements in CSR form (elements in increasing order), optionally only the
+/// triangles.
+struct Incidence {
+  std::vector<std::int32_t> start, elem;
+  Incidence(const Mesh<2>& m, bool triangles_only) : start(m.points.size() + 1, 0) {
+    auto counted = [&](std::size_t e) { return !triangles_only || m.solid.type[e] == ElemType::Tri3; };
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (!counted(e)) continue;
+      const ElemId id{static_cast<std::int32_t>(e)};
+      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) ++start[m.solid.nodes(id)[k].v + 1];
+    }
+    for (std::size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+    elem.resize(start.back());
+    std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (!counted(e)) continue;
+      const ElemId id{static_cast<std::int32_t>(e)};
+      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) elem[fill[m.solid.nodes(id)[k].v]++] = id.v;
+    }
+  }
+  std::span<const std::int32_t> of(std::int32_t v) const {
+    return {elem.data() + start[v], static_cast<std::size_t>(start[v + 1] - start[v])};
+  }
+};
+
+/// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
+int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
+  for (int k = 0; k < 3; ++k) {
+    const std::int32_t p = v[k].v, q = v[(k + 1) % 3].v;
+    if ((p == a && q == b) || (p == b && q == a)) return k;
+  }
+  return -1;
+}
+
+}  // namespace
+
+// Cost: the smallest angles are cached per element and refreshed only where a node moved or an
+// edge flipped, candidate edges are those of elements below `good`, and adjacency is CSR built
+// once per pass; the visiting order (edges by key, nodes by index) is the plain algorithm's, so
+// the result is the same as recomputing everything.
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
+  ImproveStats st;
+  const std::size_t n_nodes = m.points.size();
+  std::vector<double> angle(m.solid.size());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = min_corner_angle_deg(m, e);
+  auto mesh_min = [&] {
+    double q = 180.0;
+    for (const double a : angle) q = std::min(q, a);
+    return q;
+  };
+  st.min_angle_before = mesh_min();
+
+  // Interface edges never flip (sorted keys, binary search).
+  using EdgeKey = std::uint64_t;
+  auto key_of = [](std::int32_t a, std::int32_t b) {
+    return (static_cast<EdgeKey>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+  };
+  std::vector<EdgeKey> interface_edge;
+  for (std::size_t e = 0; e < m.interface.size(); ++e) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    interface_edge.push_back(key_of(v[0].v, v[1].v));
+  }
+  std::sort(interface_edge.begin(), interface_edge.end());
+  std::vector<std::vector<std::int32_t>> curve_neighbours(n_nodes);
+  for (std::size_t e = 0; e < m.interface.size(); ++e) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    curve_neighbours[v[0].v].push_back(v[1].v);
+    curve_neighbours[v[1].v].push_back(v[0].v);
+  }
+  for (auto& nb : curve_neighbours) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+
+  // Flips are tried only on edges of elements below `good` degrees: the interior templates have
+  // 45 degrees already, so flipping costs little beyond the boundary layer.
+  const double good = 44.0;
+  std::vector<EdgeKey> candidates;
+  std::vector<std::uint8_t> touched(m.solid.size(), 0);
+  std::vector<std::int32_t> nb;
+  for (int round = 0; round < rounds; ++round) {
+    // ---- flips: triangles only; repeat passes until none improves ----
+    for (int pass = 0; pass < 8; ++pass) {
+      candidates.clear();
+      for (std::size_t e = 0; e < m.solid.size(); ++e) {
+        if (m.solid.type[e] != ElemType::Tri3 || angle[e] >= good) continue;
+        const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+        for (int k = 0; k < 3; ++k) candidates.push_back(key_of(v[k].v, v[(k + 1) % 3].v));
+      }
+      if (candidates.empty()) break;
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
+      // are skipped for the rest of the pass.
+      const Incidence tris(m, true);
+      std::fill(touched.begin(), touched.end(), 0);
+      std::size_t flips = 0;
+      for (const EdgeKey key : candidates) {
+        const auto lo = static_cast<std::int32_t>(key >> 32), hi = static_cast<std::int32_t>(key & 0xffffffffu);
+        std::int32_t pair[2];
+        int n_pair = 0;
+        for (const std::int32_t e : tris.of(lo)) {
+          if (local_edge(m.solid.nodes(ElemId{e}), lo, hi) < 0) continue;
+          if (n_pair < 2) pair[n_pair] = e;
+          ++n_pair;
+        }
+        if (n_pair != 2) continue;  // a boundary edge, or (never in a valid mesh) an edge of 3+ triangles
+        const std::int32_t e0 = std::min(pair[0], pair[1]), e1 = std::max(pair[0], pair[1]);
+        if (angle[e0] >= good && angle[e1] >= good) continue;
+        if (std::binary_search(interface_edge.begin(), interface_edge.end(), key)) continue;
+        if (touched[e0] || touched[e1]) continue;
+        VertexId* v0 = m.solid.node.data() + m.solid.offset[e0];
+        VertexId* v1 = m.solid.node.data() + m.solid.offset[e1];
+        const int k0 = local_edge(v0, lo, hi), k1 = local_edge(v1, lo, hi);
+        // Triangle 0 = (a, b, c) with edge a-b at k0; triangle 1 = (b, a, d).
+        const std::int32_t a = v0[k0].v, b = v0[(k0 + 1) % 3].v, c = v0[(k0 + 2) % 3].v;
+        const std::int32_t d = v1[(k1 + 2) % 3].v;
+        if (v1[k1].v != b || v1[(k1 + 1) % 3].v != a) continue;  // not opposite orientation
+        const P2 &pa = m.points[a], &pb = m.points[b], &pc = m.points[c], &pd = m.points[d];
+        const double before = std::min(tri_min_angle(pa, pb, pc), tri_min_angle(pb, pa, pd));
+        const double after = std::min(tri_min_angle(pc, pa, pd), tri_min_angle(pd, pb, pc));
+        if (after <= before + 1e-9) continue;
+        // New triangles (c, a, d) and (d, b, c): both positive since after > before >= -1.
+        v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
+        v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
+        touched[e0] = touched[e1] = 1;
+        angle[e0] = min_corner_angle_deg(m, static_cast<std::size_t>(e0));
+        angle[e1] = min_corner_angle_deg(m, static_cast<std::size_t>(e1));
+        ++flips;
+      }
+      st.flips += flips;
+      if (flips == 0) break;
+    }
+
+    // ---- guarded smoothing on the smallest angle ----
+    const Incidence incident(m, false);
+    for (std::size_t v = 0; v < n_nodes; ++v) {
+      const bool sliding = locked[v] == 2 && slide;
+      const auto elems = incident.of(static_cast<std::int32_t>(v));
+      if ((locked[v] && !sliding) || elems.empty()) continue;
+      if (sliding) {
+        nb = curve_neighbours[v];
+      } else {
+        nb.clear();
+        for (const std::int32_t e : elems) {
+          const ElemId id{e};
+          const int n = m.solid.n_nodes_of(id);
+          const VertexId* ev = m.solid.nodes(id);
+          for (int k = 0; k < n; ++k) {
+            if (ev[k].v != static_cast<std::int32_t>(v)) continue;
+            nb.push_back(ev[(k + 1) % n].v);
+            nb.push_back(ev[(k + n - 1) % n].v);
+          }
+        }
+        std::sort(nb.begin(), nb.end());
+        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+      }
+      if (nb.empty()) continue;
+      P2 target = P2::Zero();
+      for (std::int32_t w : nb) target += m.points[w];
+      target /= static_cast<double>(nb.size());
+      double old_q = 180.0;
+      for (const std::int32_t e : elems) old_q = std::min(old_q, angle[e]);
+      const P2 saved = m.points[v];
+      bool moved = false;
+      for (double step : {1.0, 0.5, 0.25}) {
+        m.points[v] = saved + step * (target - saved);
+        if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
+        if (m.points[v] == saved) break;
+        double q = 180.0;
+        for (const std::int32_t e : elems) q = std::min(q, min_corner_angle_deg(m, e));
+        if (q > old_q + 1e-12) {
+          moved = true;
+          break;
+        }
+      }
+      if (moved) {
+        ++st.moves;
+        for (const std::int32_t e : elems) angle[e] = min_corner_angle_deg(m, e);
+      } else {
+        m.points[v] = saved;
+      }
+    }
+  }
+  st.min_angle_after = mesh_min();
+  return st;
+}
+
+// The plain algorithm: every angle recomputed, half-edges sorted every pass.
+ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
   ImproveStats st;
   auto mesh_min = [&] {
     double q = 180.0;

@@ -36,5 +36,9 @@ using SlideFn = std::function<Point<2>(std::int32_t v, const Point<2>& target)>;
 /// 2 is the same as 1.
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
                           const SlideFn& slide = {});
+/// Slow twin of improve_mesh (recomputes every angle, sorts all half-edges each pass): the same
+/// mesh, for tests.
+ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
+                              const SlideFn& slide = {});
 
 }  // namespace febemesh::dim2

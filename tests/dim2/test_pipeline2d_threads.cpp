@@ -1,0 +1,103 @@
+// Performance work must not change meshes: threads give the same bytes as one thread, the fast
+// quality pass gives the mesh of its slow twin, and large runs drop their stages (figures).
+
+#include <catch2/catch.hpp>
+
+#include <string>
+#include <vector>
+
+#include "core/write_msh.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/improve2d.hpp"
+#include "dim2/pipeline2d.hpp"
+#include "dim2/read_domain.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim2;
+
+namespace {
+
+std::string example(const std::string& name) { return std::string(FEBEMESH_SOURCE_DIR) + "/examples/" + name; }
+std::string glyph(const std::string& name) { return std::string(FEBEMESH_DATA_DIR) + "/2d/" + name; }
+
+Result2d run(const std::string& path, double level, ElementKind kind, int threads, int improve_rounds = 4) {
+  CurveBoundary curve(read_domain(path));
+  curve.set_global_level(level);
+  Options2d opt;
+  opt.level = level;
+  opt.elements = kind;
+  opt.keep_stages = false;
+  opt.n_threads = threads;
+  opt.improve_rounds = improve_rounds;
+  return mesh2d(curve, opt);
+}
+
+}  // namespace
+
+TEST_CASE("mesh2d gives the same mesh bytes with 1 and 2 threads", "[pipeline2d][threads]") {
+  struct Case {
+    std::string file;
+    double level;
+    ElementKind kind;
+  };
+  const std::vector<Case> cases{{example("flange.json"), 7, ElementKind::Tri},
+                                {example("bracket.json"), 6, ElementKind::Mixed},
+                                {glyph("DejaVuSans-U0041.svg"), 6, ElementKind::Tri}};
+  for (const Case& c : cases) {
+    INFO(c.file << " level " << c.level);
+    const Result2d one = run(c.file, c.level, c.kind, 1);
+    const Result2d two = run(c.file, c.level, c.kind, 2);
+    REQUIRE(one.fe.mesh.solid.size() > 100);
+    CHECK(msh_string(one.fe.mesh) == msh_string(two.fe.mesh));
+    CHECK(msh_string(one.fe.mesh, MshEncoding::Binary) == msh_string(two.fe.mesh, MshEncoding::Binary));
+  }
+}
+
+TEST_CASE("the fast quality pass gives the mesh of its slow twin", "[pipeline2d][improve]") {
+  for (const auto& [file, kind] : {std::pair{example("flange.json"), ElementKind::Tri},
+                                   std::pair{example("bracket.json"), ElementKind::Mixed},
+                                   std::pair{glyph("NimbusSans-Regular-U0067.svg"), ElementKind::Tri}}) {
+    INFO(file);
+    CurveBoundary curve(read_domain(file));
+    curve.set_global_level(6);
+    Result2d r = run(file, 6, kind, 1, 0);  // the mesh before the quality pass
+    std::vector<std::uint8_t> locked(r.fe.mesh.points.size(), 0);
+    for (std::size_t v = 0; v < r.fe.where.size(); ++v)
+      if (r.fe.where[v].patch >= 0) locked[v] = r.fe.where[v].kind == BoundaryLocation::Kind::Corner ? 1 : 2;
+    // The pipeline's slide: along the node's own loop, never onto a corner.
+    auto slide_for = [&](Mesh<2>& m, std::vector<BoundaryLocation>& where) -> SlideFn {
+      return [&m, &where, &curve](std::int32_t v, const Point<2>& target) {
+        const ClosestPoint<2> cp = curve.closest_point(target);
+        if (cp.where.patch != where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner) return m.points[v];
+        where[v] = cp.where;
+        return Point<2>(cp.point);
+      };
+    };
+    Mesh<2> fast = r.fe.mesh, slow = r.fe.mesh;
+    std::vector<BoundaryLocation> where_fast = r.fe.where, where_slow = r.fe.where;
+    const ImproveStats a = improve_mesh(fast, locked, 4, slide_for(fast, where_fast));
+    const ImproveStats b = improve_mesh_ref(slow, locked, 4, slide_for(slow, where_slow));
+    CHECK(a.flips == b.flips);
+    CHECK(a.moves == b.moves);
+    CHECK(a.min_angle_after == b.min_angle_after);
+    CHECK(a.flips + a.moves > 0);  // the pass did something to compare
+    CHECK(msh_string(fast) == msh_string(slow));
+  }
+}
+
+TEST_CASE("stages are kept only up to keep_stages_max_elements", "[pipeline2d]") {
+  CurveBoundary curve(read_domain(example("flange.json")));
+  curve.set_global_level(5);
+  Options2d opt;
+  opt.level = 5;
+  opt.keep_stages = true;
+  const Result2d kept = mesh2d(curve, opt);
+  CHECK(kept.stages_kept);
+  CHECK(kept.subdivided.n_leaves() > 1);
+  CHECK(!kept.complex.boundary.empty());
+  opt.keep_stages_max_elements = kept.fe.mesh.solid.size() - 1;
+  const Result2d dropped = mesh2d(curve, opt);
+  CHECK(!dropped.stages_kept);
+  CHECK(dropped.complex.boundary.empty());
+  CHECK(msh_string(dropped.fe.mesh) == msh_string(kept.fe.mesh));
+}
