@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -167,6 +168,20 @@ int run(const std::vector<std::string>& argv) {
                        {"off_boundary_nodes", vr.off_boundary_nodes},
                        {"max_boundary_distance", vr.max_boundary_distance},
                        {"problems", vr.problems}};
+
+  // A valid mesh can still miss part of the solid: parts thinner than the octants, dropped as
+  // islands or by the buffer rule. Say so rather than let the number hide in the report.
+  nlohmann::json warnings = nlohmann::json::array();
+  if (fid.volume_rel_error > 0.05) {
+    std::ostringstream w;
+    w.precision(3);
+    w << input << ": the mesh's volume differs from the surface's by " << 100.0 * fid.volume_rel_error
+      << "% (parts of the solid are not meshed: thin parts or dropped islands; a higher --level may"
+      << " resolve them)";
+    warnings.push_back(w.str());
+    std::cerr << "febemesh mesh3d: warning: " << w.str() << "\n";
+  }
+  rep["warnings"] = warnings;
 
   AtomicOutputDir dir{std::filesystem::path(*out)};
   write_msh(mesh, dir.file("mesh.msh"));
