@@ -10,6 +10,7 @@
 #include "core/smooth.hpp"
 #include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
+#include "dim2/optimise_angles.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -91,7 +92,9 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     FeBeMesh fe;
     if (problems.empty()) {
       say("finite elements: templates");
-      fe = fe_be_mesh(bq.complex, opt.elements, midpoint);
+      // Quad = the mixed mesh smoothed and improved, then split once and optimised.
+      const ElementKind base = opt.elements == ElementKind::Quad ? ElementKind::Mixed : opt.elements;
+      fe = fe_be_mesh(bq.complex, base, midpoint);
       clock.lap("templates");
       say("smoothing: " + std::to_string(opt.smoothing_iterations) + " Laplacian iterations");
       SmoothOptions<2> so;
@@ -110,27 +113,48 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
             fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
       }
       clock.lap("smoothing");
-      if (opt.improve_rounds > 0) {
-        say("quality: edge flips and angle-guarded smoothing");
-        std::vector<std::uint8_t> locked(fe.mesh.points.size(), 0);
+      // Interface nodes slide along their own loop, landing exactly on the curve; corners stay.
+      std::vector<std::uint8_t> locked;
+      auto lock_interface = [&] {
+        locked.assign(fe.mesh.points.size(), 0);
         for (std::size_t v = 0; v < fe.where.size(); ++v) {
           if (fe.where[v].patch < 0) continue;
           locked[v] = fe.where[v].kind == BoundaryLocation::Kind::Corner || !opt.slide_in_quality_pass ? 1 : 2;
         }
-        // Interface nodes slide along their own loop, landing exactly on the curve.
-        const SlideFn slide = [&](std::int32_t v, const Point<2>& target) {
-          const ClosestPoint<2> cp = curve.closest_point(target);
-          if (cp.where.patch != fe.where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner)
-            return fe.mesh.points[v];
-          fe.where[v] = cp.where;
-          return Point<2>(cp.point);
-        };
-        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide);
-        // A rejected slide left `where` at the tried point: recompute it from the kept position.
+      };
+      const SlideFn slide = [&](std::int32_t v, const Point<2>& target) {
+        const ClosestPoint<2> cp = curve.closest_point(target);
+        if (cp.where.patch != fe.where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner)
+          return fe.mesh.points[v];
+        fe.where[v] = cp.where;
+        return Point<2>(cp.point);
+      };
+      // A rejected slide left `where` at the tried point: recompute it from the kept position.
+      auto settle_interface = [&] {
         for (std::size_t v = 0; v < fe.where.size(); ++v)
           if (locked[v] == 2) fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
+      };
+      if (opt.improve_rounds > 0) {
+        say("quality: edge flips and angle-guarded smoothing");
+        lock_interface();
+        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide);
+        settle_interface();
         r.n_flips = is.flips;
         clock.lap("quality pass");
+      }
+      if (opt.elements == ElementKind::Quad) {
+        say("quadrilaterals: splitting every element once");
+        fe = split_to_quads(fe, midpoint);
+        clock.lap("quad split");
+      }
+      if (opt.improve_rounds > 0 && opt.elements != ElementKind::Tri) {
+        say("quality: corner-angle optimisation");
+        lock_interface();
+        AngleOptimiseOptions ao;
+        ao.rounds = 2 * opt.improve_rounds;
+        r.n_angle_moves = optimise_angles(fe.mesh, locked, ao, slide).moves;
+        settle_interface();
+        clock.lap("angle optimisation");
       }
       problems = inverted_elements(fe.mesh);
     }
