@@ -1,0 +1,259 @@
+#pragma once
+// One timed end-to-end run of febemesh and of the baseline on the same input, shared by
+// bench_mesh2d, bench_mesh3d and scaling (issues 7 and 8).
+//
+// Ours runs in process: from the parsed input to a written mesh.msh, with the pipeline's own
+// stage times. Its memory is the growth of the peak resident set over the run (the peak is
+// reset through /proc/self/clear_refs before it), so earlier runs do not hide in it.
+// Gmsh runs as a subprocess (dim2/compare_gmsh run_gmsh), inside a forked child of ours so
+// that getrusage(RUSAGE_CHILDREN) sees that one Gmsh process only; its wall time includes
+// reading the .geo and writing the .msh. TetGen runs through libtet in a forked child
+// (dim3/compare_tetgen run_in_child), from reading the .off to writing tetgen.msh.
+// Both sides are also timed in CPU seconds: the machine is shared, and CPU time is what a
+// loaded machine does not inflate.
+
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/process_stats.hpp"
+#include "core/read_msh.hpp"
+#include "core/stage_timer.hpp"
+#include "core/write_msh.hpp"
+#include "dim2/compare_gmsh.hpp"
+#include "dim2/curve_boundary.hpp"
+#include "dim2/pipeline2d.hpp"
+#include "dim2/read_domain.hpp"
+#include "dim3/compare_tetgen.hpp"
+#include "dim3/pipeline3d.hpp"
+#include "dim3/read_surface.hpp"
+
+namespace febemesh::bench {
+
+namespace fs = std::filesystem;
+
+inline double cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+struct OurRun {
+  bool ok = false;
+  std::string error;
+  double level = 0.0;
+  std::size_t elements = 0, nodes = 0;
+  double wall_seconds = 0.0, cpu_seconds = 0.0;
+  long peak_bytes = 0;  ///< growth of the peak RSS over the run
+  std::vector<StageTime> stages;  ///< the pipeline's, then "write mesh.msh"
+  double elements_per_second() const { return wall_seconds > 0 ? double(elements) / wall_seconds : 0.0; }
+  double elements_per_cpu_second() const { return cpu_seconds > 0 ? double(elements) / cpu_seconds : 0.0; }
+  double bytes_per_element() const { return elements ? double(peak_bytes) / double(elements) : 0.0; }
+};
+
+/// User + system seconds of the waited-for children so far.
+inline double children_cpu_seconds() {
+  rusage ru{};
+  getrusage(RUSAGE_CHILDREN, &ru);
+  return double(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) + 1e-6 * double(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+struct BaselineRun {
+  bool ok = false;
+  std::string error;
+  std::string settings;
+  std::size_t elements = 0;
+  double wall_seconds = 0.0;
+  double cpu_seconds = 0.0;  ///< user + system time of the baseline's process
+  long peak_bytes = 0;  ///< Gmsh: its whole process's max RSS; TetGen: peak RSS growth of the child
+  int trials = 0;
+  double elements_per_second() const { return wall_seconds > 0 ? double(elements) / wall_seconds : 0.0; }
+  double elements_per_cpu_second() const { return cpu_seconds > 0 ? double(elements) / cpu_seconds : 0.0; }
+  double bytes_per_element() const { return elements ? double(peak_bytes) / double(elements) : 0.0; }
+};
+
+/// Times `body` (which returns the mesh) plus write_msh into dir/mesh.msh.
+template <int Dim, class Body> OurRun timed_run(const fs::path& dir, Body&& body) {
+  OurRun run;
+  fs::create_directories(dir);
+  reset_peak_memory();
+  const long rss0 = current_memory_bytes();
+  const double c0 = cpu_seconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    auto [mesh, times] = body();
+    const auto tw = std::chrono::steady_clock::now();
+    write_msh<Dim>(mesh, dir / "mesh.msh");
+    const auto t1 = std::chrono::steady_clock::now();
+    run.wall_seconds = std::chrono::duration<double>(t1 - t0).count();
+    run.cpu_seconds = cpu_seconds() - c0;
+    run.peak_bytes = peak_memory_bytes() - rss0;
+    run.elements = mesh.solid.size();
+    run.nodes = mesh.points.size();
+    run.stages = std::move(times);
+    run.stages.push_back({"write mesh.msh", std::chrono::duration<double>(t1 - tw).count()});
+    run.ok = true;
+  } catch (const std::exception& e) {
+    run.error = e.what();
+  }
+  return run;
+}
+
+inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir) {
+  OurRun run = timed_run<2>(dir, [&] {
+    dim2::CurveBoundary curve = base;
+    curve.set_global_level(level);
+    dim2::Options2d opt;
+    opt.level = level;
+    opt.keep_stages = false;
+    opt.n_threads = threads;
+    dim2::Result2d r = dim2::mesh2d(curve, opt);
+    return std::pair{std::move(r.fe.mesh), std::move(r.times)};
+  });
+  run.level = level;
+  return run;
+}
+
+inline OurRun run_ours_3d(const std::string& path, int level, int threads, const fs::path& dir) {
+  OurRun run = timed_run<3>(dir, [&] {
+    dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
+    dim3::Options3d opt;
+    opt.level = level;
+    opt.n_threads = threads;
+    dim3::Result3d r = dim3::mesh3d(s, opt);
+    return std::pair{std::move(r.fe.mesh), std::move(r.times)};
+  });
+  run.level = level;
+  return run;
+}
+
+/// One Gmsh run of size h in a forked child; the child reports through a pipe.
+inline BaselineRun gmsh_trial(const dim2::CurveBoundary& curve, double h, const fs::path& dir) {
+  BaselineRun b;
+  int fd[2];
+  if (pipe(fd) != 0) {
+    b.error = std::string("pipe: ") + std::strerror(errno);
+    return b;
+  }
+  const pid_t pid = fork();
+  if (pid == 0) {
+    close(fd[0]);
+    std::ostringstream os;
+    os.precision(17);
+    try {
+      const dim2::GmshRun g = dim2::run_gmsh("gmsh", dim2::gmsh_geo(curve, h), dir, "gmsh");
+      rusage ru{};
+      getrusage(RUSAGE_CHILDREN, &ru);
+      std::string err = g.error;
+      for (char& c : err)
+        if (c == '\n') c = ' ';
+      os << g.ok << ' ' << g.mesh.solid.size() << ' ' << g.wall_seconds << ' ' << children_cpu_seconds() << ' '
+         << long(ru.ru_maxrss) * 1024 << ' ' << err;
+    } catch (const std::exception& e) {
+      os << "0 0 0 0 0 " << e.what();
+    }
+    const std::string s = os.str();
+    if (write(fd[1], s.data(), s.size()) < 0) _exit(2);
+    _exit(0);
+  }
+  close(fd[1]);
+  std::string text;
+  char buf[4096];
+  for (ssize_t n; (n = read(fd[0], buf, sizeof buf)) > 0;) text.append(buf, std::size_t(n));
+  close(fd[0]);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  std::istringstream is(text);
+  int ok = 0;
+  if (!(is >> ok >> b.elements >> b.wall_seconds >> b.cpu_seconds >> b.peak_bytes)) {
+    b.error = "the Gmsh child died";
+    return b;
+  }
+  std::getline(is >> std::ws, b.error);
+  b.ok = ok != 0;
+  return b;
+}
+
+/// Gmsh at `target` triangles (+-tolerance): uniform size h from the area, rescaled by the
+/// square root of the count ratio.
+inline BaselineRun run_gmsh_matched(const dim2::CurveBoundary& curve, std::size_t target, const fs::path& dir,
+                                    double tolerance = 0.2, int max_trials = 4) {
+  fs::create_directories(dir);
+  double h = std::sqrt(4.0 * curve.area() / (std::sqrt(3.0) * double(target)));
+  BaselineRun best;
+  for (int t = 0; t < max_trials; ++t) {
+    BaselineRun b = gmsh_trial(curve, h, dir);
+    b.trials = t + 1;
+    std::ostringstream s;
+    s << "gmsh -2 -nt 1, uniform size h = " << std::setprecision(4) << h;
+    b.settings = s.str();
+    best = b;
+    if (!b.ok || b.elements == 0) break;
+    const double n = double(b.elements);
+    if (std::abs(n - double(target)) <= tolerance * double(target)) break;
+    h *= std::sqrt(n / double(target));
+  }
+  return best;
+}
+
+/// TetGen (-pq1.414/10, volume bound rescaled) at `target` tets (+-tolerance), each trial in a
+/// forked child.
+inline BaselineRun run_tetgen_matched(const std::string& path, std::size_t target, double volume,
+                                      const fs::path& dir, double tolerance = 0.2, int max_trials = 4) {
+  fs::create_directories(dir);
+  double bound = 2.0 * std::abs(volume) / double(target);
+  BaselineRun best;
+  const fs::path out = dir / "tetgen.msh";
+  for (int t = 0; t < max_trials; ++t) {
+    std::ostringstream sw;
+    sw.precision(6);
+    sw << "pq1.414/10a" << bound << "Q";
+    const std::string switches = sw.str();
+    const double cpu0 = children_cpu_seconds();
+    const dim3::ChildResult c = dim3::run_in_child([&] {
+      const Mesh<3> m = dim3::tetgen_mesh(dim3::read_surface(path), switches);
+      write_msh<3>(m, out);
+    });
+    BaselineRun b;
+    b.trials = t + 1;
+    b.settings = "libtet tetrahedralize(\"" + switches + "\")";
+    b.ok = c.ok;
+    b.error = c.error;
+    b.wall_seconds = c.wall_seconds;
+    b.cpu_seconds = children_cpu_seconds() - cpu0;
+    b.peak_bytes = c.peak_memory_growth_bytes;
+    if (c.ok) b.elements = read_msh<3>(out).solid.size();
+    best = b;
+    if (!b.ok || b.elements == 0) break;
+    const double n = double(b.elements);
+    if (std::abs(n - double(target)) <= tolerance * double(target)) break;
+    bound *= n / double(target);
+  }
+  return best;
+}
+
+/// "1.23e+05"-style compact numbers for tables.
+inline std::string sci(double v, int digits = 3) {
+  std::ostringstream os;
+  os << std::setprecision(digits) << v;
+  return os.str();
+}
+
+inline std::string fixed(double v, int decimals = 3) {
+  std::ostringstream os;
+  os << std::fixed << std::setprecision(decimals) << v;
+  return os.str();
+}
+
+}  // namespace febemesh::bench
