@@ -141,7 +141,8 @@ int main(int argc, char** argv) {
       j["peak_bytes"] = run.peak_bytes;
       j["bytes_per_element"] = run.bytes_per_element();
       for (const StageTime& s : run.stages) {
-        j["stages"][s.name] = j["stages"].value(s.name, 0.0) + s.seconds;
+        const double before = j["stages"].contains(s.name) ? j["stages"][s.name].get<double>() : 0.0;
+        j["stages"][s.name] = before + s.seconds;
         if (std::find(stage_names.begin(), stage_names.end(), s.name) == stage_names.end()) stage_names.push_back(s.name);
       }
       if (t.trials > 0) {
