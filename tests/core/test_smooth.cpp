@@ -76,8 +76,8 @@ TEMPLATE_TEST_CASE_SIG("boundary nodes slide with a projection", "[smooth]", ((i
     if (p[1] == 0.0 && p[0] > 0.0 && p[0] < n) p[0] *= 0.5;
   REQUIRE(is_valid(mesh));
   const double q_before = min_quality(mesh);
-  // Projection onto the nearest facet of the box [0, n]^Dim.
-  auto project = [n](const Point<Dim>& p) {
+  // Projection onto the nearest facet of the box [0, n]^Dim (n is a constant: no capture).
+  auto project = [](const Point<Dim>& p) {
     Point<Dim> q = p.cwiseMax(0.0).cwiseMin(double(n));
     int best = 0;
     double dist = 1e300;
