@@ -106,7 +106,6 @@ int main(int argc, char** argv) {
   table << "| input | target | level | elements | wall s | cpu s | el/s (wall) | el/s (cpu) | peak MB | B/el | Gmsh el "
            "| Gmsh s | Gmsh cpu s | Gmsh el/s | Gmsh el/s (cpu) | Gmsh B/el | ratio (wall) | ratio (cpu) |\n"
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  std::vector<std::string> stage_names;
   std::vector<std::pair<std::string, OurRun>> all;
 
   for (const std::string& input : inputs) {
@@ -173,21 +172,9 @@ int main(int argc, char** argv) {
       j["elements_per_second"] = run.elements_per_second();
       j["peak_bytes"] = run.peak_bytes;
       j["bytes_per_element"] = run.bytes_per_element();
-      for (const StageTime& s : run.stages) {
-        j["stages"][s.name] = s.seconds;
-        if (std::find(stage_names.begin(), stage_names.end(), s.name) == stage_names.end()) stage_names.push_back(s.name);
-      }
+      j["stages"] = stages_json(run);
       if (g.trials > 0) {
-        j["gmsh"] = {{"ok", g.ok},
-                     {"error", g.error},
-                     {"settings", g.settings},
-                     {"elements", g.elements},
-                     {"wall_seconds", g.wall_seconds},
-                     {"cpu_seconds", g.cpu_seconds},
-                     {"elements_per_second", g.elements_per_second()},
-                     {"peak_bytes", g.peak_bytes},
-                     {"bytes_per_element", g.bytes_per_element()},
-                     {"trials", g.trials}};
+        j["gmsh"] = baseline_json(g);
         j["speed_ratio"] = ratio;
         j["speed_ratio_cpu"] = cpu_ratio;
       }
@@ -196,21 +183,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  stages_table << "| run |";
-  for (const auto& s : stage_names) stages_table << " " << s << " |";
-  stages_table << "\n|---|";
-  for (std::size_t k = 0; k < stage_names.size(); ++k) stages_table << "---|";
-  stages_table << "\n";
-  for (const auto& [tag, run] : all) {
-    stages_table << "| " << tag << " |";
-    for (const auto& s : stage_names) {
-      double t = 0.0;
-      for (const StageTime& st : run.stages)
-        if (st.name == s) t += st.seconds;
-      stages_table << " " << fixed(t) << " |";
-    }
-    stages_table << "\n";
-  }
+  stages_table << stage_table(all);
 
   std::ostringstream md;
   md << "# bench_mesh2d: febemesh vs Gmsh, end to end\n\n"

@@ -76,7 +76,6 @@ int main(int argc, char** argv) {
   table << "| input | level | tets | wall s | cpu s | tets/s (wall) | tets/s (cpu) | peak MB | B/tet | TetGen tets | "
            "TetGen s | TetGen cpu s | TetGen tets/s | TetGen tets/s (cpu) | TetGen B/tet | ratio (wall) | ratio (cpu) |\n"
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-  std::vector<std::string> stage_names;
   std::vector<std::pair<std::string, OurRun>> all;
 
   for (const std::string& input : inputs) {
@@ -140,22 +139,9 @@ int main(int argc, char** argv) {
       j["elements_per_second"] = run.elements_per_second();
       j["peak_bytes"] = run.peak_bytes;
       j["bytes_per_element"] = run.bytes_per_element();
-      for (const StageTime& s : run.stages) {
-        const double before = j["stages"].contains(s.name) ? j["stages"][s.name].get<double>() : 0.0;
-        j["stages"][s.name] = before + s.seconds;
-        if (std::find(stage_names.begin(), stage_names.end(), s.name) == stage_names.end()) stage_names.push_back(s.name);
-      }
+      j["stages"] = stages_json(run);
       if (t.trials > 0) {
-        j["tetgen"] = {{"ok", t.ok},
-                       {"error", t.error},
-                       {"settings", t.settings},
-                       {"elements", t.elements},
-                       {"wall_seconds", t.wall_seconds},
-                     {"cpu_seconds", t.cpu_seconds},
-                       {"elements_per_second", t.elements_per_second()},
-                       {"peak_bytes", t.peak_bytes},
-                       {"bytes_per_element", t.bytes_per_element()},
-                       {"trials", t.trials}};
+        j["tetgen"] = baseline_json(t);
         j["speed_ratio"] = ratio;
         j["speed_ratio_cpu"] = cpu_ratio;
       }
@@ -164,21 +150,7 @@ int main(int argc, char** argv) {
     }
   }
 
-  stages_table << "| run |";
-  for (const auto& s : stage_names) stages_table << " " << s << " |";
-  stages_table << "\n|---|";
-  for (std::size_t k = 0; k < stage_names.size(); ++k) stages_table << "---|";
-  stages_table << "\n";
-  for (const auto& [tag, run] : all) {
-    stages_table << "| " << tag << " |";
-    for (const auto& s : stage_names) {
-      double sum = 0.0;
-      for (const StageTime& st : run.stages)
-        if (st.name == s) sum += st.seconds;
-      stages_table << " " << fixed(sum) << " |";
-    }
-    stages_table << "\n";
-  }
+  stages_table << stage_table(all);
 
   std::ostringstream md;
   md << "# bench_mesh3d: febemesh vs TetGen, end to end\n\n"

@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -26,6 +27,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "core/process_stats.hpp"
 #include "core/read_msh.hpp"
@@ -254,6 +257,53 @@ inline std::string fixed(double v, int decimals = 3) {
   std::ostringstream os;
   os << std::fixed << std::setprecision(decimals) << v;
   return os.str();
+}
+
+/// Stage name -> seconds of one run (a stage that repeats, e.g. repairs, is summed).
+inline nlohmann::json stages_json(const OurRun& run) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const StageTime& s : run.stages) j[s.name] = j.value(s.name, 0.0) + s.seconds;
+  return j;
+}
+
+/// A baseline tool's run with the same keys for Gmsh and TetGen.
+inline nlohmann::json baseline_json(const BaselineRun& b) {
+  return {{"ok", b.ok},
+          {"error", b.error},
+          {"settings", b.settings},
+          {"elements", b.elements},
+          {"wall_seconds", b.wall_seconds},
+          {"cpu_seconds", b.cpu_seconds},
+          {"elements_per_second", b.elements_per_second()},
+          {"peak_bytes", b.peak_bytes},
+          {"bytes_per_element", b.bytes_per_element()},
+          {"trials", b.trials}};
+}
+
+/// Markdown table of the stage times (seconds, wall) of tagged runs, one column per stage name
+/// in order of first appearance.
+inline std::string stage_table(const std::vector<std::pair<std::string, OurRun>>& runs) {
+  std::vector<std::string> names;
+  for (const auto& [tag, run] : runs)
+    for (const StageTime& s : run.stages)
+      if (std::find(names.begin(), names.end(), s.name) == names.end()) names.push_back(s.name);
+  std::ostringstream t;
+  t << "| run |";
+  for (const auto& n : names) t << " " << n << " |";
+  t << "\n|---|";
+  for (std::size_t k = 0; k < names.size(); ++k) t << "---|";
+  t << "\n";
+  for (const auto& [tag, run] : runs) {
+    t << "| " << tag << " |";
+    for (const auto& n : names) {
+      double sum = 0.0;
+      for (const StageTime& st : run.stages)
+        if (st.name == n) sum += st.seconds;
+      t << " " << fixed(sum) << " |";
+    }
+    t << "\n";
+  }
+  return t.str();
 }
 
 }  // namespace febemesh::bench
