@@ -6,8 +6,8 @@
 // so q >= 1 means the element meets its bar. Laplacian smoothing and the triangle quality pass
 // (improve2d) move a node toward the centroid of its neighbours; that is not enough for quads,
 // whose largest angle matters as much as the smallest, nor for the quads made by splitting
-// triangles (whose corner angles start as the triangle's). Here each node whose elements are
-// below `target` tries the centroid of its neighbours and small pattern steps around its
+// triangles (whose corner angles start as the triangle's), and it stops short of 30 deg for
+// triangles next to the curve. Here each node whose elements are below `target` tries the centroid of its neighbours and small pattern steps around its
 // position, and keeps the best candidate only if the worst q of its elements rises. No element
 // ever inverts (an inverted or reflex corner gives q < 0, which is never accepted).
 // Deterministic: nodes are visited in index order, candidates in a fixed order.

@@ -54,7 +54,7 @@ struct Result2d {
   std::vector<Problem> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_rejected = 0;
   std::size_t n_flips = 0;          ///< edge flips of the quality pass
-  std::size_t n_angle_moves = 0;    ///< node moves of the corner-angle optimisation (quad, mixed)
+  std::size_t n_angle_moves = 0;    ///< node moves of the corner-angle optimisation
   std::vector<StageTime> times;
 };
 

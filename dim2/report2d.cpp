@@ -48,6 +48,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   bq["corners_inserted"] = r.stats.n_corners_inserted;
   bq["projections_merged"] = r.stats.n_merged;
   bq["edge_flips"] = r.n_flips;
+  bq["angle_optimisation_moves"] = r.n_angle_moves;
   bq["corners_missed"] = r.stats.n_corners_missed;
   bq["buffer_dropped"] = r.n_buffer_dropped;
   bq["pinches_dropped"] = r.n_pinches_dropped;

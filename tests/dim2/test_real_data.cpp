@@ -1,8 +1,8 @@
 // Real-data regression (issue 5): every 2D file of the shared data (FEBEMESH_DATA_DIR/2d) and
 // every bundled example (examples/*.json), at levels 4 to 8 (issue 4's bar) and the three
 // element kinds, meshed by the whole pipeline and checked by the core validator and the
-// quality bars: triangles >= 20 deg away from input corners sharper than 20 deg, quads within
-// [30, 150] deg away from input corners sharper than 30 deg. The combinations that fail
+// quality bars: triangles >= 20 deg away from input corners sharper than 20 deg (>= 29.5 in tri
+// mode), quads within [30, 150] deg away from input corners sharper than 30 deg. The combinations that fail
 // today are listed in known_failures and run in their own `[!mayfail]` test cases, named after
 // the failure, so that CI stays green while the failures stay visible in every run (none today).
 
@@ -85,6 +85,9 @@ void check_combo(const Combo& c) {
     const AnglesAwayFromCorners tri = angles_away_from_sharp_corners(out.r.fe.mesh, bare, 20.0);
     const AnglesAwayFromCorners quad = angles_away_from_sharp_corners(out.r.fe.mesh, bare, 30.0);
     CHECK(tri.min_triangle_deg >= 20.0);
+    // Beyond the bar: the corner-angle optimisation reaches 30 deg (the goal after it) on
+    // every file in tri mode (measured 30.0 at worst); assert it with a small margin.
+    if (c.kind == ElementKind::Tri) CHECK(tri.min_triangle_deg >= 29.5);
     // Quads split from the triangles of a wedge sharper than 20 deg (the NACA trailing edge,
     // 16.6 deg) reach beyond the exempt zone: there the bar is relaxed to [15, 165] (issue 4
     // note); everywhere else [30, 150] holds.
