@@ -8,6 +8,7 @@
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
+#include "dim3/triangle_predicates.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -238,24 +239,13 @@ void add_face_corners(LatticeNodes<3>& nodes, const std::vector<FreeFacet<3>>& f
 
 bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit) {
   double best = std::numeric_limits<double>::infinity();
-  const P3 d = end - q;
   s.tree().for_each_on_segment(q, end, [&](std::int32_t t) {
     const auto& v = s.tree().points(t);
-    const P3 e1 = v[1] - v[0], e2 = v[2] - v[0];
-    const P3 pv = d.cross(e2);
-    const double det = e1.dot(pv);
-    if (std::abs(det) < 1e-300) return;
-    const P3 tv = q - v[0];
-    const double u = tv.dot(pv) / det;
-    if (u < 0 || u > 1) return;
-    const P3 qv = tv.cross(e1);
-    const double w = d.dot(qv) / det;
-    if (w < 0 || u + w > 1) return;
-    const double tt = e2.dot(qv) / det;
+    const double tt = line_triangle_parameter(q, end, v[0], v[1], v[2]);
     if (tt > 0 && tt <= 1 && tt < best) best = tt;
   });
   if (!std::isfinite(best)) return false;
-  hit = q + best * d;
+  hit = q + best * (end - q);
   return true;
 }
 

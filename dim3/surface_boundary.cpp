@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "dim3/read_surface.hpp"
 #include "dim3/surface_checks.hpp"
+#include "dim3/triangle_predicates.hpp"
 
 namespace febemesh::dim3 {
 
@@ -71,17 +72,7 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
       tree_.for_each_on_segment(from, to, [&](std::int32_t u) {
         if (u == t) return;
         const auto& q = tree_.points(u);
-        const P3 e1 = q[1] - q[0], e2 = q[2] - q[0], d = to - from;
-        const P3 pv = d.cross(e2);
-        const double det = e1.dot(pv);
-        if (std::abs(det) < 1e-300) return;
-        const P3 tv = from - q[0];
-        const double a = tv.dot(pv) / det;
-        if (a < 0 || a > 1) return;
-        const P3 qv = tv.cross(e1);
-        const double b = d.dot(qv) / det;
-        if (b < 0 || a + b > 1) return;
-        const double s = e2.dot(qv) / det;
+        const double s = line_triangle_parameter(from, to, q[0], q[1], q[2]);
         if (s > 0 && s < best) best = s;
       });
       if (std::isfinite(best) && best > 0) {

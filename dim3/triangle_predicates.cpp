@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace febemesh::dim3 {
 
@@ -98,6 +99,21 @@ double closest_on_segment(const P3& p, const P3& a, const P3& b) {
   const double len2 = ab.squaredNorm();
   if (!(len2 > 0.0)) return 0.0;
   return std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
+}
+
+double line_triangle_parameter(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c) {
+  constexpr double none = std::numeric_limits<double>::infinity();
+  const P3 e1 = b - a, e2 = c - a, d = q - p;
+  const P3 pv = d.cross(e2);
+  const double det = e1.dot(pv);
+  if (std::abs(det) < 1e-300) return none;
+  const P3 tv = p - a;
+  const double u = tv.dot(pv) / det;
+  if (u < 0 || u > 1) return none;
+  const P3 qv = tv.cross(e1);
+  const double w = d.dot(qv) / det;
+  if (w < 0 || u + w > 1) return none;
+  return e2.dot(qv) / det;
 }
 
 Crossing segment_triangle(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c) {

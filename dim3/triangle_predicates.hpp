@@ -44,6 +44,11 @@ enum class Crossing : std::uint8_t { Miss, Proper, Degenerate };
 /// tolerance (through an edge or vertex, an endpoint on the plane, or coplanar overlap).
 Crossing segment_triangle(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c);
 
+/// The parameter s at which the line p + s (q - p) meets the closed triangle (a, b, c)
+/// (Moller-Trumbore, barycentrics in [0, 1]); infinity when the line is parallel to the plane
+/// or passes outside. Callers bound s themselves (a ray: s > 0; the segment: 0 < s <= 1).
+double line_triangle_parameter(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c);
+
 /// Do two triangles that share no vertex intersect beyond the tolerance? Non-coplanar pairs:
 /// some edge of one properly crosses the other. Coplanar pairs: their interiors overlap.
 bool triangles_intersect(const P3 (&t1)[3], const P3 (&t2)[3]);
