@@ -165,14 +165,7 @@ int main(int argc, char** argv) {
       j["target"] = target;
       j["level"] = level;
       j["threads"] = threads;
-      j["elements"] = run.elements;
-      j["nodes"] = run.nodes;
-      j["wall_seconds"] = run.wall_seconds;
-      j["cpu_seconds"] = run.cpu_seconds;
-      j["elements_per_second"] = run.elements_per_second();
-      j["peak_bytes"] = run.peak_bytes;
-      j["bytes_per_element"] = run.bytes_per_element();
-      j["stages"] = stages_json(run);
+      j.update(run_json(run));
       if (g.trials > 0) {
         j["gmsh"] = baseline_json(g);
         j["speed_ratio"] = ratio;

@@ -266,6 +266,18 @@ inline nlohmann::json stages_json(const OurRun& run) {
   return j;
 }
 
+/// Our run's size, times and memory (the same keys in 2D and 3D), stages included.
+inline nlohmann::json run_json(const OurRun& run) {
+  return {{"elements", run.elements},
+          {"nodes", run.nodes},
+          {"wall_seconds", run.wall_seconds},
+          {"cpu_seconds", run.cpu_seconds},
+          {"elements_per_second", run.elements_per_second()},
+          {"peak_bytes", run.peak_bytes},
+          {"bytes_per_element", run.bytes_per_element()},
+          {"stages", stages_json(run)}};
+}
+
 /// A baseline tool's run with the same keys for Gmsh and TetGen.
 inline nlohmann::json baseline_json(const BaselineRun& b) {
   return {{"ok", b.ok},
