@@ -121,7 +121,8 @@ Row solve(double a, double b, int level) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::filesystem::path out = argc > 1 ? argv[1] : FEBEMESH_SOURCE_DIR "/results/bem_check";
+  const std::filesystem::path out =
+      argc > 1 ? std::filesystem::path(argv[1]) : std::filesystem::path(FEBEMESH_SOURCE_DIR) / "results/bem_check";
   std::filesystem::create_directories(out);
   std::ostringstream md, csv;
   md << "# BEM check: capacity of a circle and an ellipse on febemesh's BE mesh\n\n"

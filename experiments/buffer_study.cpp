@@ -208,7 +208,7 @@ void plot(const std::map<std::pair<bool, double>, Summary>& sums, const fs::path
 }  // namespace
 
 int main(int argc, char** argv) {
-  fs::path out = FEBEMESH_SOURCE_DIR "/results/buffer_study";
+  fs::path out = fs::path(FEBEMESH_SOURCE_DIR) / "results/buffer_study";
   bool quick = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -222,10 +222,10 @@ int main(int argc, char** argv) {
   // The inputs: the bundled examples (file units: cm) and the glyphs (font units), at the level
   // their comparison runs use (6) and one finer; --quick: the examples at one level.
   std::vector<std::string> inputs;
-  for (const auto& e : fs::directory_iterator(FEBEMESH_SOURCE_DIR "/examples"))
+  for (const auto& e : fs::directory_iterator(fs::path(FEBEMESH_SOURCE_DIR) / "examples"))
     if (e.path().extension() == ".json") inputs.push_back(e.path().string());
   if (!quick)
-    for (const auto& e : fs::directory_iterator(FEBEMESH_DATA_DIR "/2d"))
+    for (const auto& e : fs::directory_iterator(fs::path(FEBEMESH_DATA_DIR) / "2d"))
       if (e.path().extension() == ".svg") inputs.push_back(e.path().string());
   std::sort(inputs.begin(), inputs.end());
   const std::vector<int> levels = quick ? std::vector<int>{5} : std::vector<int>{5, 6};

@@ -211,8 +211,9 @@ Errors solve_poisson(const Mesh<2>& m) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string input = argc > 1 ? argv[1] : FEBEMESH_SOURCE_DIR "/examples/flange.json";
-  const std::filesystem::path out = argc > 2 ? argv[2] : FEBEMESH_SOURCE_DIR "/results/convergence";
+  const std::string input = argc > 1 ? std::string(argv[1]) : std::string(FEBEMESH_SOURCE_DIR) + "/examples/flange.json";
+  const std::filesystem::path out =
+      argc > 2 ? std::filesystem::path(argv[2]) : std::filesystem::path(FEBEMESH_SOURCE_DIR) / "results/convergence";
   std::filesystem::create_directories(out);
   std::cout << "Poisson convergence on " << input << "\n";
 

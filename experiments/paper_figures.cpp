@@ -538,11 +538,12 @@ std::string figures_for(const std::string& input, const fs::path& out, const std
 }  // namespace
 
 int main(int argc, char** argv) {
-  const fs::path out = argc > 1 ? argv[1] : FEBEMESH_SOURCE_DIR "/results/paper_figures";
+  const fs::path out = argc > 1 ? fs::path(argv[1]) : fs::path(FEBEMESH_SOURCE_DIR) / "results/paper_figures";
   std::vector<std::string> inputs;
   for (int i = 2; i < argc; ++i) inputs.push_back(argv[i]);
   if (inputs.empty())
-    inputs = {FEBEMESH_SOURCE_DIR "/examples/bracket.json", FEBEMESH_SOURCE_DIR "/examples/flange.json"};
+    inputs = {std::string(FEBEMESH_SOURCE_DIR) + "/examples/bracket.json",
+              std::string(FEBEMESH_SOURCE_DIR) + "/examples/flange.json"};
   fs::create_directories(out);
   std::cout << "The paper's Figures 1-12 for " << inputs.size() << " examples, into " << out.string() << "\n";
   std::ostringstream md;
