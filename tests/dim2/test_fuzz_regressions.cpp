@@ -21,7 +21,8 @@ TEST_CASE("inputs found by the fuzzers are read or refused with InputError", "[f
       {"svg", febemesh::fuzz::svg_input},
       {"native", febemesh::fuzz::native_input},
       {"poly", febemesh::fuzz::poly_input},
-      {"off", febemesh::fuzz::off_input}};
+      {"off", febemesh::fuzz::off_input},
+      {"stl", febemesh::fuzz::stl_input}};
   for (const auto& [dir, run] : targets) {
     if (!fs::exists(root / dir)) continue;
     std::vector<fs::path> files;
