@@ -34,7 +34,9 @@ const char* help_text =
     "  -o DIR              output folder (mesh.msh, mesh.vtu, report.json), written atomically\n"
     "  --level N           global octree level at the surface (1..9, default 4)\n"
     "  --extra-levels N    extra levels for curvature and features (0..4, default 2)\n"
-    "  --elements KIND     tet (default); hex is not available yet\n"
+    "  --elements KIND     tet (default), or hex: hex-dominant (hexahedra where the octants\n"
+    "                      conform, pyramids and tetrahedra elsewhere; quad BE faces where\n"
+    "                      a hexahedron's or pyramid's surface face stays a quad)\n"
     "  --buffer X          drop interior octants nearer the surface than X times their size\n"
     "                      (0..0.5, default 0.2)\n"
     "  --smooth N          smoothing iterations (0..50, default 4)\n"
@@ -74,7 +76,7 @@ int run(const std::vector<std::string>& argv) {
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
   opt.snap_features = !args.has("--no-features");
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
-  if (elements == "hex") throw UsageError("--elements hex is not available yet (use tet)");
+  opt.hex_dominant = elements == "hex";
   const bool quiet = args.has("--quiet");
   const auto progress = [&](const std::string& s) {
     if (!quiet) std::cerr << "mesh3d: " << s << "\n";
@@ -119,8 +121,8 @@ int run(const std::vector<std::string>& argv) {
   std::size_t n_interior = 0;
   for (auto f : r.interior) n_interior += f ? 1 : 0;
   rep["counts"] = {{"nodes", mesh.points.size()},
-                   {"tetrahedra", mesh.solid.size()},
-                   {"interface_triangles", mesh.interface.size()},
+                   {"tetrahedra", opt.hex_dominant ? r.hex.n_tet : mesh.solid.size()},
+                   {"interface_triangles", opt.hex_dominant ? r.hex.n_interface_triangles : mesh.interface.size()},
                    {"leaves_subdivided", r.n_leaves_subdivided},
                    {"leaves", r.tree.n_leaves()},
                    {"interior_octants", n_interior},
@@ -150,6 +152,20 @@ int run(const std::vector<std::string>& argv) {
   times["validate_and_measure"] = t_check;
   rep["timings_s"] = times;
   rep["quality"] = quality_json(q);
+  if (opt.hex_dominant)
+    rep["hex_dominant"] = {{"hexahedra", r.hex.n_hex},
+                           {"pyramids", r.hex.n_pyramid},
+                           {"tetrahedra", r.hex.n_tet},
+                           {"interface_quads", r.hex.n_interface_quads},
+                           {"interface_triangles", r.hex.n_interface_triangles},
+                           {"hex_share", r.hex.hex_share()},
+                           {"hex_volume_share", r.hex.hex_volume_share()},
+                           {"hex_candidates", r.hex.n_hex_candidates},
+                           {"hex_rejected", r.hex.n_hex_rejected},
+                           {"hex_demoted", r.hex.n_hex_demoted},
+                           {"faces_split", r.hex.n_faces_split},
+                           {"min_hex_scaled_jacobian", opt.hex.min_hex_scaled_jacobian},
+                           {"min_scaled_jacobian", q.min_scaled_jacobian}};
   rep["fidelity"] = {{"surface_volume", fid.surface_volume},
                      {"fe_volume", fid.fe_volume},
                      {"volume_rel_error", fid.volume_rel_error},
@@ -192,7 +208,7 @@ int run(const std::vector<std::string>& argv) {
     if (!os) throw InputError(dir.file("report.json").string() + ": cannot write");
   }
   dir.commit();
-  progress("wrote " + dir.final_path().string() + ": " + std::to_string(mesh.solid.size()) + " tetrahedra, " +
+  progress("wrote " + dir.final_path().string() + ": " + std::to_string(mesh.solid.size()) + (opt.hex_dominant ? " solid elements, " : " tetrahedra, ") +
            std::to_string(mesh.interface.size()) + " interface triangles, min dihedral " +
            std::to_string(q.min_angle_deg) + " deg" + (vr.valid ? "" : " (INVALID)"));
   if (!vr.valid) {

@@ -296,6 +296,11 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
         problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});
     }
     if (problems.empty()) {
+      if (opt.hex_dominant) {
+        say("finite elements: hexahedra where the cells conform");
+        r.hex = make_hex_dominant(tree, oc.complex, fe, opt.hex);
+        clock.lap("hex-dominant");
+      }
       r.stats = oc.stats;
       r.fe = std::move(fe);
       r.interior = std::move(in);

@@ -14,6 +14,7 @@
 #include "core/orthtree.hpp"
 #include "core/stage_timer.hpp"
 #include "dim3/boundary_octants.hpp"
+#include "dim3/hex_dominant.hpp"
 #include "dim3/surface_boundary.hpp"
 #include "dim3/templates3d.hpp"
 
@@ -35,6 +36,8 @@ struct Options3d {
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
+  bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
+  HexDominantOptions hex;
 };
 
 using StageTime3 = StageTime;
@@ -56,6 +59,7 @@ struct Result3d {
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
   std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
+  HexDominantStats hex;              ///< with opt.hex_dominant
   std::vector<StageTime3> times;
 };
 

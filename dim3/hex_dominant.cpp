@@ -1,0 +1,330 @@
+#include "dim3/hex_dominant.hpp"
+
+#include <algorithm>
+#include <map>
+#include <optional>
+
+#include "core/cube_faces.hpp"
+#include "core/error.hpp"
+#include "core/quality.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+using LP = LatticePoint<3>;
+using Ring4 = std::array<std::int32_t, 4>;
+
+LP midpoint(const LP& a, const LP& b) { return {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2}; }
+
+Ring4 sorted(Ring4 r) {
+  std::sort(r.begin(), r.end());
+  return r;
+}
+
+bool distinct(const Ring4& r) {
+  const Ring4 s = sorted(r);
+  return s[0] != s[1] && s[1] != s[2] && s[2] != s[3];
+}
+
+/// The square's four node ids when the template face rule keeps it a plain quad (no lattice
+/// node at its centre or at an edge midpoint), in the order of `q`.
+std::optional<Ring4> plain_square(const LatticeNodes<3>& lattice, const std::array<LP, 4>& q, std::uint32_t len) {
+  if (len >= 2) {
+    if (lattice.find(midpoint(q[0], q[2])) >= 0) return std::nullopt;
+    for (int k = 0; k < 4; ++k)
+      if (lattice.find(midpoint(q[k], q[(k + 1) % 4])) >= 0) return std::nullopt;
+  }
+  Ring4 r;
+  for (int k = 0; k < 4; ++k) {
+    r[k] = lattice.find(q[k]);
+    MESH_ASSERT(r[k] >= 0, "square corner is not a lattice node");
+  }
+  return r;
+}
+
+/// A plain quad face of one cell: outward ring (counter-clockwise seen from outside the cell),
+/// the global face it is, and the cell's two cones that cover it.
+struct QuadFace {
+  Ring4 ring{};
+  std::size_t face = 0;
+  std::array<std::size_t, 2> cones{};
+  bool pyramid_ok = false;
+};
+
+struct CellInfo {
+  std::vector<std::size_t> cones;  // tets of the cell, ascending
+  std::int32_t apex = -1;
+  std::vector<QuadFace> quads;
+  bool candidate = false;  // all six faces plain quads
+  Ring4 lower{}, upper{};  // hex in Gmsh order: lower face, then the nodes above each
+  bool is_hex = false;
+};
+
+struct Faces {
+  std::map<Ring4, std::size_t> index;
+  std::vector<int> n_cells;
+  std::vector<std::uint8_t> split, surface;
+
+  std::size_t get(const Ring4& r) {
+    const auto [it, added] = index.emplace(sorted(r), n_cells.size());
+    if (added) {
+      n_cells.push_back(0);
+      split.push_back(0);
+      surface.push_back(0);
+    }
+    return it->second;
+  }
+};
+
+ElemPoints<3> points_of(const std::vector<P3>& pts, std::initializer_list<std::int32_t> ids) {
+  ElemPoints<3> out;
+  for (std::int32_t v : ids) out.p[out.n++] = pts[v];
+  return out;
+}
+
+/// Base triangle of a template cone (t0, t2, t1, apex) as a sorted id triple.
+std::array<std::int32_t, 3> base_key(const VertexId* n) {
+  std::array<std::int32_t, 3> k{n[0].v, n[1].v, n[2].v};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+/// Registers the plain quad `ring` of cell `ci` and finds its two cones; a quad the cell's cones
+/// do not cover exactly twice is split at once (both sides then keep their triangles).
+void add_quad(const Mesh<3>& m, CellInfo& ci, Faces& faces, const Ring4& ring, bool surface) {
+  QuadFace q;
+  q.ring = ring;
+  q.face = faces.get(ring);
+  ++faces.n_cells[q.face];
+  if (surface) faces.surface[q.face] = 1;
+  int n = 0;
+  for (std::size_t e : ci.cones) {
+    const auto k = base_key(m.solid.nodes(ElemId{static_cast<std::int32_t>(e)}));
+    const bool inside = std::all_of(k.begin(), k.end(), [&](std::int32_t v) {
+      return std::find(ring.begin(), ring.end(), v) != ring.end();
+    });
+    if (!inside) continue;
+    if (n < 2) q.cones[n] = e;
+    ++n;
+  }
+  if (n != 2) {
+    faces.split[q.face] = 1;
+    return;
+  }
+  ci.quads.push_back(q);
+}
+
+}  // namespace
+
+HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc, TetMesh& fe,
+                                   const HexDominantOptions& opt) {
+  HexDominantStats st;
+  Mesh<3>& m = fe.mesh;
+  MESH_ASSERT(fe.cell.size() == m.solid.size(), "cell per element");
+  const std::size_t n_interior = oc.interior.size();
+  std::vector<CellInfo> cells(n_interior + oc.boundary.size());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    MESH_ASSERT(m.solid.type[e] == ElemType::Tet4, "make_hex_dominant takes the template tets");
+    CellInfo& ci = cells[fe.cell[e]];
+    ci.cones.push_back(e);
+    const std::int32_t apex = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)})[3].v;
+    MESH_ASSERT(ci.apex < 0 || ci.apex == apex, "cones of one cell share the centroid");
+    ci.apex = apex;
+  }
+
+  Faces faces;
+  for (std::size_t k = 0; k < n_interior; ++k) {
+    CellInfo& ci = cells[k];
+    if (ci.cones.empty()) continue;
+    const Cell<3>& c = t.leaf(oc.interior[k]);
+    int n_plain = 0;
+    for (int f = 0; f < Cube<3>::n_faces; ++f) {
+      const auto& fc = FaceCorners<3>::corners[f];
+      const auto r = plain_square(oc.lattice, {corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])},
+                                  length(c));
+      if (!r) continue;
+      ++n_plain;
+      add_quad(m, ci, faces, *r, false);
+    }
+    if (n_plain == Cube<3>::n_faces) {
+      // Gmsh order: corners 0 1 3 2 (z low, counter-clockwise seen from above), then above them.
+      constexpr std::array<int, 8> gmsh = {0, 1, 3, 2, 4, 5, 7, 6};
+      for (int i = 0; i < 4; ++i) {
+        ci.lower[i] = oc.lattice.find(corner(c, gmsh[i]));
+        ci.upper[i] = oc.lattice.find(corner(c, gmsh[i + 4]));
+      }
+      ci.candidate = true;
+    }
+  }
+  for (std::size_t k = 0; k < oc.boundary.size(); ++k) {
+    CellInfo& ci = cells[n_interior + k];
+    if (ci.cones.empty()) continue;
+    const BoundaryOctant& bo = oc.boundary[k];
+    const std::size_t n = bo.ring.size();
+    std::vector<std::int32_t> p(n);
+    for (std::size_t i = 0; i < n; ++i) p[i] = oc.projection[bo.ring[i]];
+    int n_plain = 0;
+    const auto& fc = FaceCorners<3>::corners[bo.face];
+    const auto q = plain_square(
+        oc.lattice, {corner(bo.cell, fc[0]), corner(bo.cell, fc[1]), corner(bo.cell, fc[2]), corner(bo.cell, fc[3])},
+        length(bo.cell));
+    if (q) {
+      // Seen from the boundary octant, the interior octant's face turns the other way.
+      add_quad(m, ci, faces, {(*q)[0], (*q)[3], (*q)[2], (*q)[1]}, false);
+      ++n_plain;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t j = (i + 1) % n;
+      const Ring4 side{bo.ring[i], bo.ring[j], p[j], p[i]};
+      if (!distinct(side)) continue;
+      add_quad(m, ci, faces, side, false);
+      ++n_plain;
+    }
+    if (n == 4) {
+      const Ring4 top{p[0], p[1], p[2], p[3]};
+      if (distinct(top)) {
+        add_quad(m, ci, faces, top, true);
+        ++n_plain;
+      }
+    }
+    if (n == 4 && n_plain == Cube<3>::n_faces) {
+      // The ring turns counter-clockwise seen from the projections: the lower face of the hex.
+      for (int i = 0; i < 4; ++i) ci.lower[i] = bo.ring[i], ci.upper[i] = p[i];
+      ci.candidate = true;
+    }
+  }
+  // A quad that only one cell sees as a quad, inside the solid, cannot stay one.
+  for (std::size_t f = 0; f < faces.n_cells.size(); ++f)
+    if (faces.n_cells[f] != 2 && !faces.surface[f]) faces.split[f] = 1;
+
+  const std::vector<P3>& pts = m.points;
+  for (CellInfo& ci : cells) {
+    for (QuadFace& q : ci.quads) {
+      const auto ep = points_of(pts, {q.ring[0], q.ring[3], q.ring[2], q.ring[1], ci.apex});
+      q.pyramid_ok = min_corner_jacobian<3>(ElemType::Pyramid5, ep.span()) > 0 &&
+                     scaled_jacobian<3>(ElemType::Pyramid5, ep.span()) > 1e-6;
+    }
+    if (!ci.candidate) continue;
+    ++st.n_hex_candidates;
+    const auto& lo = ci.lower;
+    const auto& up = ci.upper;
+    const auto ep = points_of(pts, {lo[0], lo[1], lo[2], lo[3], up[0], up[1], up[2], up[3]});
+    ci.is_hex = min_corner_jacobian<3>(ElemType::Hex8, ep.span()) > 0 &&
+                scaled_jacobian<3>(ElemType::Hex8, ep.span()) >= opt.min_hex_scaled_jacobian;
+    if (!ci.is_hex) ++st.n_hex_rejected;
+  }
+
+  // Splits only grow and hexes only shrink, so this ends.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (CellInfo& ci : cells) {
+      if (ci.is_hex && std::any_of(ci.quads.begin(), ci.quads.end(), [&](const QuadFace& q) { return faces.split[q.face]; })) {
+        ci.is_hex = false;
+        ++st.n_hex_demoted;
+        changed = true;
+      }
+      if (ci.is_hex) continue;
+      for (const QuadFace& q : ci.quads)
+        if (!q.pyramid_ok && !faces.split[q.face]) faces.split[q.face] = 1, changed = true;
+    }
+  }
+  for (std::size_t f = 0; f < faces.split.size(); ++f) st.n_faces_split += faces.split[f];
+
+  // The solid elements, cell by cell in the order of the cones.
+  Elements solid;
+  std::vector<std::uint8_t> level, from_boundary;
+  std::vector<std::int32_t> cell_of;
+  std::vector<std::uint8_t> used(pts.size(), 0);
+  const auto emit = [&](ElemType type, std::initializer_list<std::int32_t> ids, std::size_t like, std::int32_t cell) {
+    std::array<VertexId, 8> v;
+    int n = 0;
+    for (std::int32_t id : ids) v[n++] = VertexId{id}, used[id] = 1;
+    solid.add(type, v.data(), n);
+    level.push_back(m.level.empty() ? 0 : m.level[like]);
+    from_boundary.push_back(m.from_boundary_cell.empty() ? 0 : m.from_boundary_cell[like]);
+    cell_of.push_back(cell);
+    const auto ep = element_points<3>(solid, ElemId{static_cast<std::int32_t>(solid.size() - 1)}, pts);
+    const double vol = signed_measure<3>(type, ep.span());
+    st.total_volume += vol;
+    if (type == ElemType::Hex8) st.hex_volume += vol;
+  };
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    const CellInfo& ci = cells[k];
+    if (ci.cones.empty()) continue;
+    const std::int32_t cell = static_cast<std::int32_t>(k);
+    const std::size_t like = ci.cones.front();
+    if (ci.is_hex) {
+      const auto& lo = ci.lower;
+      const auto& up = ci.upper;
+      emit(ElemType::Hex8, {lo[0], lo[1], lo[2], lo[3], up[0], up[1], up[2], up[3]}, like, cell);
+      ++st.n_hex;
+      continue;
+    }
+    std::vector<std::size_t> merged;
+    for (const QuadFace& q : ci.quads) {
+      if (faces.split[q.face]) continue;
+      // The apex sees the outward ring turning clockwise: reversed, it is the pyramid's base.
+      emit(ElemType::Pyramid5, {q.ring[0], q.ring[3], q.ring[2], q.ring[1], ci.apex}, like, cell);
+      ++st.n_pyramid;
+      merged.insert(merged.end(), q.cones.begin(), q.cones.end());
+    }
+    for (std::size_t e : ci.cones) {
+      if (std::find(merged.begin(), merged.end(), e) != merged.end()) continue;
+      const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+      emit(ElemType::Tet4, {v[0].v, v[1].v, v[2].v, v[3].v}, e, cell);
+      ++st.n_tet;
+    }
+  }
+
+  // The BE mesh: a kept surface quad replaces its two triangles, where the first one was.
+  std::map<std::array<std::int32_t, 3>, std::size_t> tri_to_quad;  // -> index in `quads`
+  std::vector<Ring4> quads;
+  for (const CellInfo& ci : cells)
+    for (const QuadFace& q : ci.quads) {
+      if (!faces.surface[q.face] || faces.split[q.face]) continue;
+      for (std::size_t e : q.cones) tri_to_quad[base_key(m.solid.nodes(ElemId{static_cast<std::int32_t>(e)}))] = quads.size();
+      quads.push_back(q.ring);
+    }
+  Elements interface;
+  std::vector<std::uint8_t> quad_done(quads.size(), 0);
+  for (std::size_t f = 0; f < m.interface.size(); ++f) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    MESH_ASSERT(m.interface.type[f] == ElemType::Tri3, "template interface triangles");
+    std::array<std::int32_t, 3> key{v[0].v, v[1].v, v[2].v};
+    std::sort(key.begin(), key.end());
+    const auto it = tri_to_quad.find(key);
+    if (it == tri_to_quad.end()) {
+      interface.add(ElemType::Tri3, {v[0], v[1], v[2]});
+      ++st.n_interface_triangles;
+    } else if (!quad_done[it->second]) {
+      quad_done[it->second] = 1;
+      const Ring4& r = quads[it->second];
+      interface.add(ElemType::Quad4, {VertexId{r[0]}, VertexId{r[1]}, VertexId{r[2]}, VertexId{r[3]}});
+      ++st.n_interface_quads;
+    }
+    for (int i = 0; i < 3; ++i) used[v[i].v] = 1;
+  }
+
+  // Drop the nodes nothing uses any more (the centroids of hexes), keeping the others' order.
+  std::vector<std::int32_t> renumber(pts.size(), -1);
+  std::vector<P3> points;
+  std::vector<BoundaryLocation> where;
+  for (std::size_t v = 0; v < pts.size(); ++v) {
+    if (!used[v]) continue;
+    renumber[v] = static_cast<std::int32_t>(points.size());
+    points.push_back(pts[v]);
+    where.push_back(v < fe.where.size() ? fe.where[v] : BoundaryLocation{});
+  }
+  for (VertexId& v : solid.node) v.v = renumber[v.v];
+  for (VertexId& v : interface.node) v.v = renumber[v.v];
+  m.points = std::move(points);
+  m.solid = std::move(solid);
+  m.interface = std::move(interface);
+  m.level = std::move(level);
+  m.from_boundary_cell = std::move(from_boundary);
+  fe.where = std::move(where);
+  fe.cell = std::move(cell_of);
+  return st;
+}
+
+}  // namespace febemesh::dim3
