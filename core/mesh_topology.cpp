@@ -147,44 +147,8 @@ int orientation_of(const Facet& f) {
 
 namespace {
 
-/// Sorts by (key, element, local facet). When every key has at most two nodes (2D meshes) the
-/// order is that of two packed 64-bit words, sorted without comparing key arrays element by
-/// element; otherwise the four ids are compared in turn. Same order either way.
-void sort_uses(std::vector<FacetUse>& uses) {
-  const bool two_nodes = std::all_of(uses.begin(), uses.end(), [](const FacetUse& u) { return u.key.v[2] < 0; });
-  if (two_nodes) {
-    struct Packed {
-      std::uint64_t key, rest;
-      std::uint32_t index;
-    };
-    std::vector<Packed> packed(uses.size());
-    for (std::size_t i = 0; i < uses.size(); ++i) {
-      const FacetUse& u = uses[i];
-      // Ids are >= -1: offset by one so that the unsigned order is the signed one.
-      const auto a = static_cast<std::uint64_t>(static_cast<std::int64_t>(u.key.v[0]) + 1);
-      const auto b = static_cast<std::uint64_t>(static_cast<std::int64_t>(u.key.v[1]) + 1);
-      const auto rest = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(u.elem.v)) << 8) |
-                        static_cast<std::uint8_t>(u.local);
-      packed[i] = {(a << 32) | b, rest, static_cast<std::uint32_t>(i)};
-    }
-    std::sort(packed.begin(), packed.end(),
-              [](const Packed& x, const Packed& y) { return x.key != y.key ? x.key < y.key : x.rest < y.rest; });
-    std::vector<FacetUse> sorted(uses.size());
-    for (std::size_t i = 0; i < packed.size(); ++i) sorted[i] = uses[packed[i].index];
-    uses = std::move(sorted);
-    return;
-  }
-  std::sort(uses.begin(), uses.end(), [](const FacetUse& a, const FacetUse& b) {
-    for (int k = 0; k < 4; ++k)
-      if (a.key.v[k] != b.key.v[k]) return a.key.v[k] < b.key.v[k];
-    if (a.elem.v != b.elem.v) return a.elem.v < b.elem.v;
-    return a.local < b.local;
-  });
-}
-
-}  // namespace
-
-std::vector<FacetUse> facet_uses(const Elements& els) {
+/// Every facet use in generation order: (element, local facet) increasing.
+std::vector<FacetUse> unsorted_uses(const Elements& els) {
   std::vector<FacetUse> uses;
   std::size_t total = 0;
   for (std::size_t e = 0; e < els.size(); ++e) total += static_cast<std::size_t>(n_facets(els.type[e]));
@@ -196,27 +160,103 @@ std::vector<FacetUse> facet_uses(const Elements& els) {
       uses.push_back({key_of(fc), id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(orientation_of(fc))});
     }
   }
-  sort_uses(uses);
   return uses;
 }
 
-std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
-  const std::vector<FacetUse> uses = facet_uses(solid);
-  std::vector<BoundaryFacet> out;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 1) out.push_back({facet_of(solid, uses[i].elem, uses[i].local), uses[i].elem, uses[i].local});
-    i = j;
-  }
-  std::sort(out.begin(), out.end(), [](const BoundaryFacet& a, const BoundaryFacet& b) {
-    return a.elem.v != b.elem.v ? a.elem.v < b.elem.v : a.local < b.local;
-  });
+/// Stable counting sort of `items` by bucket(item) in [0, n_buckets); `start` receives the
+/// bucket boundaries (n_buckets + 1 entries).
+template <class T, class Bucket>
+std::vector<T> bucket_sort(const std::vector<T>& items, std::size_t n_buckets, Bucket bucket,
+                           std::vector<std::size_t>& start) {
+  start.assign(n_buckets + 1, 0);
+  for (const T& x : items) ++start[bucket(x) + 1];
+  for (std::size_t b = 0; b < n_buckets; ++b) start[b + 1] += start[b];
+  std::vector<T> out(items.size());
+  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+  for (const T& x : items) out[fill[bucket(x)]++] = x;
   return out;
 }
 
-std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
+/// Stable sort of the short range [first, last) (a bucket: the uses or edges of one node).
+template <class It, class Less> void sort_bucket(It first, It last, Less less) {
+  if (last - first > 32) {
+    std::stable_sort(first, last, less);
+    return;
+  }
+  for (It i = first + (first != last); i < last; ++i)
+    for (It j = i; j != first && less(*j, *(j - 1)); --j) std::iter_swap(j, j - 1);
+}
+
+}  // namespace
+
+// Cost: the uses are generated in (element, local facet) order, so a stable counting sort by the
+// smallest node followed by a stable sort of each node's few uses by the remaining key gives the
+// (key, element, local) order in linear time (facet_uses_ref: one comparison sort, same order).
+std::vector<FacetUse> facet_uses(const Elements& els) {
+  const std::vector<FacetUse> uses = unsorted_uses(els);
+  std::int64_t top = -1;
+  for (const FacetUse& u : uses) top = std::max<std::int64_t>(top, u.key.v[0]);
+  // Ids are >= -1: bucket = smallest id + 1.
+  std::vector<std::size_t> start;
+  std::vector<FacetUse> sorted = bucket_sort(uses, static_cast<std::size_t>(top + 2),
+                                             [](const FacetUse& u) { return static_cast<std::size_t>(u.key.v[0] + 1); },
+                                             start);
+  for (std::size_t b = 0; b + 1 < start.size(); ++b)
+    sort_bucket(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
+                sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]), [](const FacetUse& x, const FacetUse& y) {
+                  for (int k = 1; k < 4; ++k)
+                    if (x.key.v[k] != y.key.v[k]) return x.key.v[k] < y.key.v[k];
+                  return false;
+                });
+  return sorted;
+}
+
+std::vector<FacetUse> facet_uses_ref(const Elements& els) {
+  std::vector<FacetUse> uses = unsorted_uses(els);
+  std::sort(uses.begin(), uses.end(), [](const FacetUse& a, const FacetUse& b) {
+    for (int k = 0; k < 4; ++k)
+      if (a.key.v[k] != b.key.v[k]) return a.key.v[k] < b.key.v[k];
+    if (a.elem.v != b.elem.v) return a.elem.v < b.elem.v;
+    return a.local < b.local;
+  });
+  return uses;
+}
+
+// The facets used once are flagged by (element, local facet) and read back in that order.
+std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
+  const std::vector<FacetUse> uses = facet_uses(solid);
+  std::vector<std::size_t> first(solid.size() + 1, 0);
+  for (std::size_t e = 0; e < solid.size(); ++e) first[e + 1] = first[e] + static_cast<std::size_t>(n_facets(solid.type[e]));
+  std::vector<std::uint8_t> once(first.back(), 0);
+  std::size_t n_once = 0;
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i + 1;
+    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    if (j - i == 1) {
+      once[first[uses[i].elem.v] + static_cast<std::size_t>(uses[i].local)] = 1;
+      ++n_once;
+    }
+    i = j;
+  }
+  std::vector<BoundaryFacet> out;
+  out.reserve(n_once);
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (std::size_t f = first[e]; f < first[e + 1]; ++f) {
+      if (!once[f]) continue;
+      const ElemId id{static_cast<std::int32_t>(e)};
+      const int local = static_cast<int>(f - first[e]);
+      out.push_back({facet_of(solid, id, local), id, local});
+    }
+  return out;
+}
+
+namespace {
+
+std::vector<std::array<VertexId, 2>> edge_list(const Elements& els) {
   std::vector<std::array<VertexId, 2>> edges;
+  std::size_t total = 0;
+  for (std::size_t e = 0; e < els.size(); ++e) total += static_cast<std::size_t>(n_edges(els.type[e]));
+  edges.reserve(total);
   for (std::size_t e = 0; e < els.size(); ++e) {
     const VertexId* nodes = els.nodes(ElemId{static_cast<std::int32_t>(e)});
     for (int k = 0; k < n_edges(els.type[e]); ++k) {
@@ -226,6 +266,29 @@ std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
       edges.push_back({u, w});
     }
   }
+  return edges;
+}
+
+}  // namespace
+
+// Cost: linear, a counting sort by the smaller node then each node's few edges sorted.
+std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
+  const std::vector<std::array<VertexId, 2>> edges = edge_list(els);
+  std::int64_t top = -1;
+  for (const auto& e : edges) top = std::max<std::int64_t>(top, e[0].v);
+  std::vector<std::size_t> start;
+  std::vector<std::array<VertexId, 2>> sorted = bucket_sort(
+      edges, static_cast<std::size_t>(top + 2), [](const auto& e) { return static_cast<std::size_t>(e[0].v + 1); }, start);
+  for (std::size_t b = 0; b + 1 < start.size(); ++b)
+    sort_bucket(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
+                sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]),
+                [](const auto& x, const auto& y) { return x[1].v < y[1].v; });
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  return sorted;
+}
+
+std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els) {
+  std::vector<std::array<VertexId, 2>> edges = edge_list(els);
   std::sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) {
     return x[0].v != y[0].v ? x[0].v < y[0].v : x[1].v < y[1].v;
   });

@@ -53,6 +53,8 @@ struct FacetUse {
 
 /// Every facet use of `els`, sorted by (key, element, local facet): equal keys are adjacent.
 std::vector<FacetUse> facet_uses(const Elements& els);
+/// Slow twin of facet_uses (one comparison sort): the same vector.
+std::vector<FacetUse> facet_uses_ref(const Elements& els);
 
 /// A facet of the solid used by exactly one element, oriented outward.
 struct BoundaryFacet {
@@ -67,5 +69,7 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid);
 
 /// Distinct edges of `els` as sorted node pairs, sorted.
 std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els);
+/// Slow twin of unique_edges (one comparison sort): the same vector.
+std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els);
 
 }  // namespace febemesh
