@@ -8,12 +8,20 @@
 // (and with it the coarsest balanced refinement) is the closure computed level by level, finest
 // first, each level sorted and deduplicated once. The leaves are then the children of internal
 // cells that are not internal, emitted in Morton order by one depth-first walk.
+//
+// With several threads (BalanceOptions::n_threads) each level's candidates are generated and
+// sorted in parallel, in pieces cut at sibling groups, and merged; the final walk is cut into
+// subtrees whose place in the output is known beforehand from counts of internal cells, so the
+// threads write their parts of the result directly. The result is the same for any thread count.
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
+#include <exception>
 #include <sstream>
+#include <thread>
 
 #include "core/error.hpp"
-#include "core/huge_pages.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
@@ -69,6 +77,94 @@ template <int Dim> [[noreturn]] void refuse_balance(std::size_t n_leaves, std::s
   throw LimitError(os.str());
 }
 
+/// Runs f(t) on threads t = 0..n_threads-1 (t = 0 on the caller), waits for all, and rethrows
+/// the first exception of the lowest thread.
+template <class F> void on_threads(int n_threads, const F& f) {
+  if (n_threads <= 1) {
+    f(0);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_threads));
+  const auto guarded = [&](int t) {
+    try {
+      f(t);
+    } catch (...) {
+      errors[std::size_t(t)] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < n_threads; ++t) threads.emplace_back(guarded, t);
+  guarded(0);
+  for (auto& th : threads) th.join();
+  for (const auto& e : errors) {
+    if (e) std::rethrow_exception(e);
+  }
+}
+
+/// Appends to `out` the parents of the sibling groups in here[begin, end) (internal cells at
+/// `level`) and the same-size neighbours of those parents that the rule requires.
+template <int Dim>
+void append_candidates(const std::vector<std::uint64_t>& here, std::size_t begin, std::size_t end, int level,
+                       BalanceKind kind, std::vector<std::uint64_t>& out) {
+  constexpr std::size_t nc = Cube<Dim>::n_children;
+  const int pl = level - 1;
+  const std::uint64_t parent_mask = ~((std::uint64_t(1) << (Dim * (max_level<Dim> - pl))) - 1);
+  const int child_shift = Dim * (max_level<Dim> - level);
+  // One sibling group at a time: the union of outward sides of its internal children says
+  // which neighbours of the parent are required.
+  for (std::size_t i = begin; i < end;) {
+    const std::uint64_t pk = here[i] & parent_mask;
+    unsigned present = 0;  // bit k: child k of the parent is internal
+    for (; i < end && (here[i] & parent_mask) == pk; ++i) {
+      present |= 1u << ((here[i] >> child_shift) & (nc - 1));
+    }
+    out.push_back(pk);
+    // A direction is a subset of axes plus a side on each; it leaves the parent only from a
+    // child lying on that side along every axis of the subset.
+    for (int axes = 1; axes < int(nc); ++axes) {
+      if (!Directions<Dim>::wanted(axes, kind)) continue;
+      for (int signs = 0; signs < int(nc); ++signs) {
+        if ((signs & ~axes) != 0) continue;
+        bool reachable = false;
+        for (int k = 0; k < int(nc); ++k) {
+          if (((present >> k) & 1u) && (k & axes) == signs) reachable = true;
+        }
+        if (!reachable) continue;
+        int dir[Dim];
+        for (int d = 0; d < Dim; ++d) dir[d] = ((axes >> d) & 1) ? (((signs >> d) & 1) ? 1 : -1) : 0;
+        std::uint64_t nk;
+        if (neighbour_key<Dim>(pk, pl, dir, nk)) out.push_back(nk);
+      }
+    }
+  }
+}
+
+/// Writes the leaves of the subtree below internal cell `p` (index `index` at its level) in
+/// Morton order: children of internal cells that are not internal. A depth-first walk meets each
+/// level's internal cells in increasing key order, so one cursor per level suffices.
+template <int Dim> struct Walker {
+  const std::vector<std::vector<std::uint8_t>>& masks;
+  std::vector<std::size_t> cursor;  // per level: index of the next internal cell
+  Cell<Dim>* out;
+
+  void walk(const Cell<Dim>& p, std::size_t index) {
+    constexpr int nc = Cube<Dim>::n_children;
+    const int level = p.level + 1;
+    const std::uint32_t half = std::uint32_t(1) << (max_level<Dim> - level);
+    const unsigned mask = masks[p.level][index];
+    for (int i = 0; i < nc; ++i) {
+      Cell<Dim> ch;
+      ch.level = std::uint8_t(level);
+      for (int d = 0; d < Dim; ++d) ch.anchor[d] = p.anchor[d] + (((i >> d) & 1) ? half : 0);
+      if ((mask >> i) & 1u) {
+        walk(ch, cursor[std::size_t(level)]++);
+      } else {
+        ::new (static_cast<void*>(out++)) Cell<Dim>(ch);
+      }
+    }
+  }
+};
+
 }  // namespace
 
 template <int Dim>
@@ -104,50 +200,40 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   };
   check_limit(false);
 
+  const int n_threads = std::max(1, opt.n_threads);
   {
-    std::vector<std::uint64_t> candidates, merged;
+    std::vector<std::vector<std::uint64_t>> candidates(static_cast<std::size_t>(n_threads));
+    std::vector<std::uint64_t> merged;
     for (int level = deepest - 1; level >= 1; --level) {
       const auto& here = internal[level];
-      const int pl = level - 1;
-      const std::uint64_t parent_mask = ~(volume_units(Cell<Dim>{{}, std::uint8_t(pl)}) - 1);
-      const int child_shift = Dim * (max_level<Dim> - level);
-      candidates.clear();
-      // One sibling group at a time: the union of outward sides of its internal children says
-      // which neighbours of the parent are required.
-      for (std::size_t i = 0; i < here.size();) {
-        const std::uint64_t pk = here[i] & parent_mask;
-        unsigned present = 0;  // bit k: child k of the parent is internal
-        for (; i < here.size() && (here[i] & parent_mask) == pk; ++i) {
-          present |= 1u << ((here[i] >> child_shift) & (nc - 1));
-        }
-        candidates.push_back(pk);
-        // A direction is a subset of axes plus a side on each; it leaves the parent only from a
-        // child lying on that side along every axis of the subset.
-        for (int axes = 1; axes < int(nc); ++axes) {
-          if (!Directions<Dim>::wanted(axes, kind)) continue;
-          for (int signs = 0; signs < int(nc); ++signs) {
-            if ((signs & ~axes) != 0) continue;
-            bool reachable = false;
-            for (int k = 0; k < int(nc); ++k) {
-              if (((present >> k) & 1u) && (k & axes) == signs) reachable = true;
-            }
-            if (!reachable) continue;
-            int dir[Dim];
-            for (int d = 0; d < Dim; ++d) dir[d] = ((axes >> d) & 1) ? (((signs >> d) & 1) ? 1 : -1) : 0;
-            std::uint64_t nk;
-            if (neighbour_key<Dim>(pk, pl, dir, nk)) candidates.push_back(nk);
-          }
-        }
+      const std::uint64_t parent_mask = ~(volume_units(Cell<Dim>{{}, std::uint8_t(level - 1)}) - 1);
+      // Pieces of `here` cut at sibling groups (a group must not be split: its children
+      // together decide the parent's neighbours); small levels stay on one thread.
+      const int n_pieces = here.size() < 4096 ? 1 : n_threads;
+      std::vector<std::size_t> cut(static_cast<std::size_t>(n_pieces) + 1, here.size());
+      cut[0] = 0;
+      for (int t = 1; t < n_pieces; ++t) {
+        std::size_t c = std::max(cut[std::size_t(t) - 1], here.size() * std::size_t(t) / std::size_t(n_pieces));
+        while (c > 0 && c < here.size() && (here[c] & parent_mask) == (here[c - 1] & parent_mask)) ++c;
+        cut[std::size_t(t)] = c;
       }
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-      auto& below = internal[pl];
-      merged.clear();
-      merged.reserve(candidates.size() + below.size());
-      std::set_union(candidates.begin(), candidates.end(), below.begin(), below.end(),
-                     std::back_inserter(merged));
-      n_internal += merged.size() - below.size();
-      below.swap(merged);
+      on_threads(n_pieces, [&](int t) {
+        auto& mine = candidates[std::size_t(t)];
+        mine.clear();
+        append_candidates<Dim>(here, cut[std::size_t(t)], cut[std::size_t(t) + 1], level, kind, mine);
+        std::sort(mine.begin(), mine.end());
+        mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+      });
+      // Merge the sorted pieces into the level above (a union: keys may repeat across pieces).
+      auto& below = internal[level - 1];
+      for (int t = 0; t < n_pieces; ++t) {
+        const auto& mine = candidates[std::size_t(t)];
+        merged.clear();
+        merged.reserve(mine.size() + below.size());
+        std::set_union(mine.begin(), mine.end(), below.begin(), below.end(), std::back_inserter(merged));
+        n_internal += merged.size() - below.size();
+        below.swap(merged);
+      }
       check_limit(false);
     }
   }  // the work arrays are freed before the output is allocated
@@ -155,7 +241,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
 
   // The walk below needs, per internal cell, only which of its children are internal: one byte
   // instead of an 8-byte key. Built top-down so that each level's keys are freed once used.
-  std::vector<std::vector<std::uint8_t>> masks(deepest);
+  std::vector<std::vector<std::uint8_t>> masks(static_cast<std::size_t>(deepest));
   for (int level = 0; level < deepest; ++level) {
     const auto& here = internal[level];
     auto& m = masks[level];
@@ -174,17 +260,44 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
     std::vector<std::uint64_t>().swap(internal[level]);
   }
 
-  // Children of internal cells that are not internal are the leaves; a depth-first walk meets
-  // each level's internal cells in increasing key order, so one cursor per level suffices.
-  std::vector<Cell<Dim>> out;
-  out.reserve(1 + n_internal * (nc - 1));  // exact
-  advise_huge_pages(out.data(), out.capacity() * sizeof(Cell<Dim>));
-  std::vector<std::size_t> cursor(masks.size() + 1, 0);
-  struct Walker {
-    const std::vector<std::vector<std::uint8_t>>& masks;
-    std::vector<std::size_t>& cursor;
-    std::vector<Cell<Dim>>& out;
-    void walk(const Cell<Dim>& p, std::size_t index) {
+  // The output, cut into tasks: the internal cells of one split level s, whose subtrees hold
+  // every deeper internal cell, and the leaves above s between them. A task's leaves number
+  // 1 + (nc - 1) x (its internal cells), and its first internal cell at each level L >= s is
+  // the running count of internal children (popcounts of the masks) of the cells before it, so
+  // every task knows where its leaves go and where its cursors start before any is walked.
+  const std::size_t n_out = 1 + n_internal * (nc - 1);
+  int split = 0;
+  if (n_threads > 1) {
+    while (split + 1 < deepest && masks[std::size_t(split)].size() < std::size_t(n_threads) * 64) ++split;
+  }
+  const std::size_t n_levels = std::size_t(deepest - split);
+  const std::size_t n_tasks = masks[std::size_t(split)].size();
+  // first[k * n_levels + (L - split)]: index of task k's first internal cell at level L; row
+  // n_tasks holds the level sizes.
+  std::vector<std::size_t> first((n_tasks + 1) * n_levels);
+  for (std::size_t k = 0; k <= n_tasks; ++k) first[k * n_levels] = k;
+  for (std::size_t l = 0; l + 1 < n_levels; ++l) {
+    const auto& m = masks[std::size_t(split) + l];
+    std::size_t pos = 0, count = 0;
+    for (std::size_t k = 0; k <= n_tasks; ++k) {
+      const std::size_t upto = first[k * n_levels + l];
+      for (; pos < upto; ++pos) count += std::size_t(std::popcount(unsigned(m[pos])));
+      first[k * n_levels + l + 1] = count;
+    }
+  }
+  // The walk above the split level, in Morton order: leaves, and tasks (marked by level).
+  struct Item {
+    Cell<Dim> cell;
+    std::size_t task = no_leaf;  // or the index of the internal cell at the split level
+  };
+  std::vector<Item> items;
+  {
+    std::vector<std::size_t> cursor(static_cast<std::size_t>(split) + 1, 0);
+    const auto top = [&](const auto& self, const Cell<Dim>& p, std::size_t index) -> void {
+      if (p.level == split) {
+        items.push_back({p, index});
+        return;
+      }
       const int level = p.level + 1;
       const std::uint32_t half = std::uint32_t(1) << (max_level<Dim> - level);
       const unsigned mask = masks[p.level][index];
@@ -193,16 +306,49 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
         ch.level = std::uint8_t(level);
         for (int d = 0; d < Dim; ++d) ch.anchor[d] = p.anchor[d] + (((i >> d) & 1) ? half : 0);
         if ((mask >> i) & 1u) {
-          walk(ch, cursor[level]++);
+          self(self, ch, cursor[std::size_t(level)]++);
         } else {
-          out.push_back(ch);
+          items.push_back({ch, no_leaf});
         }
       }
+    };
+    top(top, Cell<Dim>{}, 0);
+  }
+  std::vector<std::size_t> offset(items.size() + 1, 0);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::size_t n = 1;
+    if (items[i].task != no_leaf) {
+      const std::size_t k = items[i].task;
+      std::size_t n_int = 0;
+      for (std::size_t l = 0; l < n_levels; ++l) n_int += first[(k + 1) * n_levels + l] - first[k * n_levels + l];
+      n = 1 + n_int * (nc - 1);
     }
-  };
-  Walker{masks, cursor, out}.walk(Cell<Dim>{}, 0);
-  MESH_ASSERT(out.size() == 1 + n_internal * (nc - 1),
-              "balanced tree has " << out.size() << " leaves for " << n_internal << " internal cells");
+    offset[i + 1] = offset[i] + n;
+  }
+  MESH_ASSERT(offset.back() == n_out, "balanced tree has " << offset.back() << " leaves for " << n_internal
+                                                           << " internal cells");
+  LeafVector<Dim> out;
+  out.resize(n_out);  // sized, not written (LeafAllocator): each cell is written once below
+  Cell<Dim>* const cells = out.data();
+  const std::size_t n_chunks = n_threads == 1 ? 1 : std::min(items.size(), std::size_t(n_threads) * 16);
+  std::atomic<std::size_t> next{0};
+  on_threads(n_threads, [&](int) {
+    Walker<Dim> w{masks, std::vector<std::size_t>(static_cast<std::size_t>(deepest) + 1, 0), nullptr};
+    for (std::size_t c; (c = next.fetch_add(1)) < n_chunks;) {
+      for (std::size_t i = items.size() * c / n_chunks, e = items.size() * (c + 1) / n_chunks; i < e; ++i) {
+        w.out = cells + offset[i];
+        if (items[i].task == no_leaf) {
+          ::new (static_cast<void*>(w.out)) Cell<Dim>(items[i].cell);
+          continue;
+        }
+        const std::size_t k = items[i].task;
+        for (std::size_t l = 0; l < n_levels; ++l) w.cursor[std::size_t(split) + l] = first[k * n_levels + l];
+        w.walk(items[i].cell, k);
+        MESH_ASSERT(w.out == cells + offset[i + 1], "task " << k << " wrote " << (w.out - cells - offset[i])
+                                                            << " leaves, expected " << (offset[i + 1] - offset[i]));
+      }
+    }
+  });
   return Orthtree<Dim>(t.root_box(), std::move(out));
 }
 

@@ -6,8 +6,20 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace febemesh {
+
+namespace detail {
+// Arrays from 4 MiB up get huge pages: below that the one partly used huge page at each end
+// would be a visible share of the array.
+void* allocate_leaf_bytes(std::size_t bytes) {
+  void* p = ::operator new(bytes);
+  if (bytes >= (std::size_t(4) << 20)) advise_huge_pages(p, bytes);
+  return p;
+}
+void deallocate_leaf_bytes(void* p, std::size_t bytes) noexcept { ::operator delete(p, bytes); }
+}  // namespace detail
 
 template <int Dim> Box<Dim> root_cube(const Box<Dim>& domain) {
   const Point<Dim> ext = domain.hi - domain.lo;
@@ -27,10 +39,14 @@ template <int Dim> Box<Dim> root_cube(const Box<Dim>& domain) {
 template <int Dim> Orthtree<Dim>::Orthtree() : Orthtree(Box<Dim>{Point<Dim>::Zero(), Point<Dim>::Ones()}) {}
 
 template <int Dim>
-Orthtree<Dim>::Orthtree(const Box<Dim>& domain) : Orthtree(root_cube(domain), {Cell<Dim>{}}) {}
+Orthtree<Dim>::Orthtree(const Box<Dim>& domain) : Orthtree(root_cube(domain), LeafVector<Dim>{Cell<Dim>{}}) {}
 
 template <int Dim>
-Orthtree<Dim>::Orthtree(const Box<Dim>& root_cube, std::vector<Cell<Dim>> leaves)
+Orthtree<Dim>::Orthtree(const Box<Dim>& root_cube, const std::vector<Cell<Dim>>& leaves)
+    : Orthtree(root_cube, LeafVector<Dim>(leaves.begin(), leaves.end())) {}
+
+template <int Dim>
+Orthtree<Dim>::Orthtree(const Box<Dim>& root_cube, LeafVector<Dim> leaves)
     : root_(root_cube), leaves_(std::move(leaves)) {
   // The side divided by a power of two is exact, so lattice positions of the upper root
   // faces land exactly on root_.hi.

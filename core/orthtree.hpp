@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "core/boundary.hpp"
@@ -16,6 +18,35 @@ namespace febemesh {
 
 inline constexpr std::size_t no_leaf = std::numeric_limits<std::size_t>::max();
 
+namespace detail {
+/// Storage for leaf arrays: operator new, plus transparent huge pages for large arrays (see
+/// huge_pages.hpp; kept out of this header so that it does not pull in <sys/mman.h>).
+void* allocate_leaf_bytes(std::size_t bytes);
+void deallocate_leaf_bytes(void* p, std::size_t bytes) noexcept;
+}  // namespace detail
+
+/// Allocator of the tree's leaf array. It differs from std::allocator in one respect: resize(n)
+/// leaves the new cells unwritten (construct() without arguments does nothing), so that threads
+/// can fill disjoint parts of a freshly sized array in parallel. Value-initialising them first
+/// would be one more serial pass over memory, and memory bandwidth, not arithmetic, is what
+/// bounds refinement and balance on two threads here. Cell is an aggregate of integers with no
+/// invariant to set up; the tree code writes every cell it adds by resize before publishing it.
+template <class T> struct LeafAllocator {
+  using value_type = T;
+  LeafAllocator() = default;
+  template <class U> constexpr LeafAllocator(const LeafAllocator<U>&) noexcept {}
+  T* allocate(std::size_t n) { return static_cast<T*>(detail::allocate_leaf_bytes(n * sizeof(T))); }
+  void deallocate(T* p, std::size_t n) noexcept { detail::deallocate_leaf_bytes(p, n * sizeof(T)); }
+  template <class U> void construct(U*) noexcept {}
+  template <class U, class A, class... Args> void construct(U* p, A&& a, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a), std::forward<Args>(args)...);
+  }
+  friend bool operator==(const LeafAllocator&, const LeafAllocator&) { return true; }
+};
+
+/// The leaves of a tree, in Morton order. A std::vector (all of its interface), see LeafAllocator.
+template <int Dim> using LeafVector = std::vector<Cell<Dim>, LeafAllocator<Cell<Dim>>>;
+
 template <int Dim> class Orthtree {
  public:
   /// One root leaf over the unit cube.
@@ -23,9 +54,11 @@ template <int Dim> class Orthtree {
   /// One root leaf over the smallest cube with lower corner domain.lo enclosing `domain`.
   explicit Orthtree(const Box<Dim>& domain);
   /// Given leaves over a root cube; in Debug asserts they are sorted, linear and complete.
-  Orthtree(const Box<Dim>& root_cube, std::vector<Cell<Dim>> leaves);
+  Orthtree(const Box<Dim>& root_cube, LeafVector<Dim> leaves);
+  /// The same from a std::vector (copied).
+  Orthtree(const Box<Dim>& root_cube, const std::vector<Cell<Dim>>& leaves);
 
-  const std::vector<Cell<Dim>>& leaves() const { return leaves_; }
+  const LeafVector<Dim>& leaves() const { return leaves_; }
   std::size_t n_leaves() const { return leaves_.size(); }
   const Cell<Dim>& leaf(std::size_t i) const { return leaves_[i]; }
   /// The root cube in real coordinates.
@@ -36,7 +69,7 @@ template <int Dim> class Orthtree {
  private:
   Box<Dim> root_;
   double unit_ = 1.0;
-  std::vector<Cell<Dim>> leaves_;
+  LeafVector<Dim> leaves_;
 };
 
 /// The smallest cube with lower corner domain.lo enclosing `domain` (the root of Orthtree(domain)).
@@ -86,6 +119,7 @@ enum class BalanceKind : std::uint8_t {
 
 struct BalanceOptions {
   std::size_t max_leaves = 200000000;  ///< refuse (LimitError) a result beyond this many leaves
+  int n_threads = 1;                   ///< results identical for any count
 };
 
 /// The coarsest refinement of `t` that is 2:1 balanced. O(n log n). Throws LimitError, with the

@@ -16,7 +16,6 @@
 #include <sys/mman.h>
 
 #include "core/error.hpp"
-#include "core/huge_pages.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
@@ -45,37 +44,38 @@ struct Budget {
   }
 };
 
-/// Append-only storage of emitted leaves in blocks mapped straight from the kernel. A growing
-/// std::vector would hold its old and new buffers at once (up to 2x the leaves at the last
-/// doubling), and blocks from malloc may stay resident after free (glibc raises its mmap
-/// threshold once a large block is freed, and the next blocks then come from an arena that is
-/// not trimmed). Own mappings are released the moment they are unmapped, so draining the spool
-/// front to back into an exactly reserved vector keeps the peak at the leaves plus one block.
-template <int Dim> class LeafSpool {
+/// Append-only storage of emitted leaves, one byte each: the level. The leaves of one work range
+/// tile a cube in Morton order, so each anchor follows from the previous leaf (its key plus its
+/// volume) and from the range's first key; the cells are rebuilt only when they are copied into
+/// the result. Writing 12-16 bytes per leaf twice (a cell spool, then the result) made refinement
+/// bound by memory bandwidth, which two threads of this machine do not double (measured: page
+/// zeroing was about half of a two-thread run). Blocks are mapped straight from the kernel and
+/// unmapped as they drain, so the spool adds at most one small block per thread to the peak.
+class LevelSpool {
  public:
-  LeafSpool() = default;
-  LeafSpool(const LeafSpool&) = delete;
-  LeafSpool& operator=(const LeafSpool&) = delete;
-  ~LeafSpool() {
-    for (Cell<Dim>* b : blocks_) {
+  LevelSpool() = default;
+  LevelSpool(const LevelSpool&) = delete;
+  LevelSpool& operator=(const LevelSpool&) = delete;
+  ~LevelSpool() {
+    for (std::uint8_t* b : blocks_) {
       if (b) munmap(b, block_bytes);
     }
   }
 
-  void push(const Cell<Dim>& c) {
-    if (fill_ == per_block) grow();
-    new (blocks_.back() + fill_) Cell<Dim>(c);
-    ++fill_;
+  void push(std::uint8_t level) {
+    if (fill_ == block_bytes) grow();
+    blocks_.back()[fill_++] = level;
     ++size_;
   }
   std::size_t size() const { return size_; }
-  /// Appends leaves [begin, end) to `out`. Ranges must be drained in increasing order: blocks
-  /// wholly before `end` are unmapped.
-  void drain(std::size_t begin, std::size_t end, std::vector<Cell<Dim>>& out) {
+  /// Calls f(level) for the leaves [begin, end). Ranges must be drained in increasing order:
+  /// blocks wholly before `end` are unmapped.
+  template <class F> void drain(std::size_t begin, std::size_t end, F&& f) {
     while (begin < end) {
-      const std::size_t b = begin / per_block, stop = std::min(end, (b + 1) * per_block);
-      out.insert(out.end(), blocks_[b] + (begin - b * per_block), blocks_[b] + (stop - b * per_block));
-      if (stop == (b + 1) * per_block) {
+      const std::size_t b = begin / block_bytes, stop = std::min(end, (b + 1) * block_bytes);
+      const std::uint8_t* block = blocks_[b];
+      for (std::size_t i = begin - b * block_bytes, n = stop - b * block_bytes; i < n; ++i) f(block[i]);
+      if (stop == (b + 1) * block_bytes) {
         munmap(blocks_[b], block_bytes);
         blocks_[b] = nullptr;
       }
@@ -84,38 +84,55 @@ template <int Dim> class LeafSpool {
   }
 
  private:
-  static constexpr std::size_t block_bytes = std::size_t(1) << 21;  // one huge page
-  static constexpr std::size_t per_block = block_bytes / sizeof(Cell<Dim>);
+  // Small pages: a block holds 256 Ki leaves and costs one fault per 4096 of them; a huge page
+  // would keep 2 MiB resident per thread for trees of any size.
+  static constexpr std::size_t block_bytes = std::size_t(1) << 18;
 
   void grow() {
-    // Map twice the size and trim to a 2 MiB-aligned block, so that it can be one huge page.
-    constexpr int prot = PROT_READ | PROT_WRITE, flags = MAP_PRIVATE | MAP_ANONYMOUS;
-    void* raw = mmap(nullptr, 2 * block_bytes, prot, flags, -1, 0);
+    void* raw = mmap(nullptr, block_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (raw == MAP_FAILED) throw std::bad_alloc();
-    const std::uintptr_t r = reinterpret_cast<std::uintptr_t>(raw);
-    const std::uintptr_t a = (r + block_bytes - 1) & ~std::uintptr_t(block_bytes - 1);
-    if (a > r) munmap(raw, a - r);
-    if (a + block_bytes < r + 2 * block_bytes) munmap(reinterpret_cast<void*>(a + block_bytes), r + block_bytes - a);
-    auto* block = reinterpret_cast<Cell<Dim>*>(a);
-    advise_huge_pages(block, block_bytes);
-    blocks_.push_back(block);
+    blocks_.push_back(static_cast<std::uint8_t*>(raw));
     fill_ = 0;
   }
 
-  std::vector<Cell<Dim>*> blocks_;
-  std::size_t fill_ = per_block;  // leaves in the last block
+  std::vector<std::uint8_t*> blocks_;
+  std::size_t fill_ = block_bytes;  // bytes used in the last block
   std::size_t size_ = 0;
 };
 
-/// Appends leaves to one spool and reports to the budget every few thousand leaves, so that
+template <int Dim> inline std::uint64_t volume_of_level(int level) {
+  return std::uint64_t(1) << (Dim * (max_level<Dim> - level));
+}
+
+/// The anchor of the leaf after a leaf of `level` at `anchor` in a complete Morton-ordered
+/// tiling: adds one to the interleaved key at that level's digit, bit by bit (two bit flips on
+/// average, where rebuilding the anchor from the key costs a full de-interleave).
+template <int Dim> inline void advance_anchor(std::array<std::uint32_t, Dim>& anchor, int level) {
+  for (int b = max_level<Dim> - level; b < max_level<Dim>; ++b) {
+    const std::uint32_t bit = std::uint32_t(1) << b;
+    for (int d = 0; d < Dim; ++d) {
+      if (!(anchor[d] & bit)) {
+        anchor[d] |= bit;
+        return;
+      }
+      anchor[d] &= ~bit;
+    }
+  }
+}
+
+/// Records leaves in one spool and reports to the budget every few thousand leaves, so that
 /// memory stays bounded by max_leaves plus one batch per thread.
 template <int Dim> class Emitter {
  public:
-  Emitter(LeafSpool<Dim>& out, Budget& budget) : out_(out), budget_(budget) {}
+  Emitter(LevelSpool& out, Budget& budget) : out_(out), budget_(budget) {}
 
   void emit(const Cell<Dim>& c) {
-    out_.push(c);
-    volume_ += volume_units(c);
+    if (!started_) {
+      first_ = c.anchor;
+      started_ = true;
+    }
+    out_.push(c.level);
+    volume_ += volume_of_level<Dim>(c.level);
     if (++pending_ == batch) flush();
   }
   void flush() {
@@ -129,13 +146,17 @@ template <int Dim> class Emitter {
     }
     if (budget_.stop) throw LimitError("refinement stopped: another thread exceeded max_leaves");
   }
+  /// Anchor of the first leaf emitted (meaningful once one was).
+  const std::array<std::uint32_t, Dim>& first() const { return first_; }
 
  private:
   static constexpr std::size_t batch = 4096;
-  LeafSpool<Dim>& out_;
+  LevelSpool& out_;
   Budget& budget_;
   std::size_t pending_ = 0;
   std::uint64_t volume_ = 0;
+  std::array<std::uint32_t, Dim> first_{};
+  bool started_ = false;
 };
 
 /// A unit of work in Morton order: a leaf to emit as is, or a subtree root to expand.
@@ -195,104 +216,99 @@ template <int Dim> struct PredicateRule {
   }
 };
 
-/// Touches every page of freshly reserved storage on n_threads threads. The kernel zeroes a
-/// page on its first touch, which otherwise happens in the serial copy into the result and was
-/// a tenth of a refinement's time (measured), the part that two threads could not share. The
-/// bytes are storage, not yet elements: the copy overwrites them.
-inline void prefault(void* storage, std::size_t bytes, int n_threads) {
-  constexpr std::size_t page = 4096;
-  auto* base = static_cast<unsigned char*>(storage);
-  const auto touch = [base, bytes](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end && i < bytes; i += page) {
-      *reinterpret_cast<volatile unsigned char*>(base + i) = 0;
-    }
-  };
-  const std::size_t pages = (bytes + page - 1) / page;
+/// Runs f(t) on threads t = 0..n_threads-1 (t = 0 on the caller) and waits for all.
+template <class F> void on_threads(int n_threads, const F& f) {
   std::vector<std::thread> threads;
-  for (int t = 1; t < n_threads; ++t) {
-    threads.emplace_back(touch, pages * std::size_t(t) / std::size_t(n_threads) * page,
-                         pages * std::size_t(t + 1) / std::size_t(n_threads) * page);
-  }
-  touch(0, pages / std::size_t(n_threads) * page);
+  for (int t = 1; t < n_threads; ++t) threads.emplace_back(f, t);
+  f(0);
   for (auto& th : threads) th.join();
 }
 
 /// Runs work(k, emitter) for k = 0..n_work-1 in order on n_threads threads and returns the
 /// leaves in that order. The result does not depend on the thread count: the work is cut into
 /// contiguous chunks, each chunk's leaves form one range of its thread's spool, and the ranges
-/// are concatenated in chunk order. Threads take chunks in increasing order, so each spool is
-/// drained front to back and frees its blocks as it goes.
+/// are placed in chunk order. Two phases: the threads expand chunks (taken dynamically, in
+/// increasing order), then, with every chunk's size and so its place in the result known, each
+/// thread writes the cells of its own chunks there. Draining its own spool front to back, it
+/// frees the spool's blocks as it goes. Both phases run in parallel: a serial copy into the
+/// result was a third of a refinement (measured) and kept two threads near 1x.
 template <int Dim, class Work>
-std::vector<Cell<Dim>> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
-  const int n_spools = std::max(1, n_threads);
-  std::vector<LeafSpool<Dim>> spools(static_cast<std::size_t>(n_spools));
+LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
+  n_threads = std::max(1, n_threads);
+  std::vector<LevelSpool> spools(static_cast<std::size_t>(n_threads));
   struct Range {
     int spool = 0;
     std::size_t begin = 0, end = 0;
-  };
-  const auto process = [&](std::size_t begin, std::size_t end, int spool, Range& range) {
-    LeafSpool<Dim>& out = spools[std::size_t(spool)];
-    range = {spool, out.size(), 0};
-    Emitter<Dim> e(out, budget);
-    for (std::size_t k = begin; k < end; ++k) work(k, e);
-    e.flush();
-    range.end = out.size();
+    std::array<std::uint32_t, Dim> first{};  // anchor of the range's first leaf
   };
   // Many more chunks than threads, taken dynamically: refinement is concentrated near the
   // boundary, so equal item counts are far from equal work.
-  const std::size_t n_chunks = n_threads <= 1 ? std::min<std::size_t>(n_work, 1)
+  const std::size_t n_chunks = n_threads == 1 ? std::min<std::size_t>(n_work, 1)
                                               : std::min(n_work, std::size_t(n_threads) * 16);
   std::vector<Range> ranges(n_chunks);
-  if (n_chunks == 1) {
-    process(0, n_work, 0, ranges[0]);
-  } else if (n_chunks > 1) {
-    std::vector<std::exception_ptr> errors(n_chunks);
-    std::atomic<std::size_t> next{0};
-    const auto worker = [&](int spool) {
-      for (;;) {
-        const std::size_t k = next.fetch_add(1);
-        if (k >= n_chunks || budget.stop) return;
-        try {
-          process(n_work * k / n_chunks, n_work * (k + 1) / n_chunks, spool, ranges[k]);
-        } catch (...) {
-          errors[k] = std::current_exception();
-          budget.stop = true;
-        }
-      }
-    };
-    std::vector<std::thread> threads;
-    for (int t = 1; t < n_threads; ++t) threads.emplace_back(worker, t);
-    worker(0);
-    for (auto& th : threads) th.join();
-    // The first refusal that exceeded the budget carries the estimate; prefer it over the
-    // "stopped" notes of the other chunks.
-    std::exception_ptr first;
-    for (const auto& err : errors) {
-      if (!err) continue;
+  std::vector<std::vector<std::size_t>> taken(static_cast<std::size_t>(n_threads));
+  std::vector<std::exception_ptr> errors(n_chunks);
+  std::atomic<std::size_t> next{0};
+  on_threads(n_threads, [&](int t) {
+    LevelSpool& out = spools[std::size_t(t)];
+    for (;;) {
+      const std::size_t k = next.fetch_add(1);
+      if (k >= n_chunks || budget.stop) return;
+      taken[std::size_t(t)].push_back(k);
+      Range& range = ranges[k];
+      range = {t, out.size(), out.size(), {}};
       try {
-        std::rethrow_exception(err);
-      } catch (const LimitError& le) {
-        if (std::string(le.what()).rfind("refinement would", 0) == 0) throw;
-        if (!first) first = err;
+        Emitter<Dim> e(out, budget);
+        for (std::size_t i = n_work * k / n_chunks, end = n_work * (k + 1) / n_chunks; i < end; ++i) work(i, e);
+        e.flush();
+        range.first = e.first();
       } catch (...) {
-        throw;
+        errors[k] = std::current_exception();
+        budget.stop = true;
       }
+      range.end = out.size();
     }
-    if (first) std::rethrow_exception(first);
+  });
+  // The first refusal that exceeded the budget carries the estimate; prefer it over the
+  // "stopped" notes of the other chunks.
+  std::exception_ptr first_error;
+  for (const auto& err : errors) {
+    if (!err) continue;
+    try {
+      std::rethrow_exception(err);
+    } catch (const LimitError& le) {
+      if (std::string(le.what()).rfind("refinement would", 0) == 0) throw;
+      if (!first_error) first_error = err;
+    } catch (...) {
+      throw;
+    }
   }
-  std::size_t total = 0;
-  for (const auto& s : spools) total += s.size();
-  std::vector<Cell<Dim>> out;
-  out.reserve(total);  // exact: pages are touched only as the spools drain into it
-  advise_huge_pages(out.data(), total * sizeof(Cell<Dim>));
-  if (n_threads > 1) prefault(out.data(), total * sizeof(Cell<Dim>), n_threads);
-  for (const Range& r : ranges) spools[std::size_t(r.spool)].drain(r.begin, r.end, out);
+  if (first_error) std::rethrow_exception(first_error);
+
+  std::vector<std::size_t> offset(n_chunks + 1, 0);
+  for (std::size_t k = 0; k < n_chunks; ++k) offset[k + 1] = offset[k] + (ranges[k].end - ranges[k].begin);
+  LeafVector<Dim> out;
+  out.resize(offset[n_chunks]);  // sized, not written (LeafAllocator): the threads write each cell once
+  Cell<Dim>* const cells = out.data();
+  on_threads(n_threads, [&](int t) {
+    for (const std::size_t k : taken[std::size_t(t)]) {
+      const Range& r = ranges[k];
+      Cell<Dim>* dst = cells + offset[k];
+      Cell<Dim> c;
+      c.anchor = r.first;
+      spools[std::size_t(t)].drain(r.begin, r.end, [&](std::uint8_t level) {
+        c.level = level;
+        ::new (static_cast<void*>(dst++)) Cell<Dim>(c);
+        advance_anchor<Dim>(c.anchor, level);
+      });
+    }
+  });
   return out;
 }
 
 /// Expands `items` in order with `rule`.
 template <int Dim, class Rule>
-std::vector<Cell<Dim>> expand_items(const std::vector<Item<Dim>>& items, const Rule& rule,
+LeafVector<Dim> expand_items(const std::vector<Item<Dim>>& items, const Rule& rule,
                                     Budget& budget, int n_threads) {
   return expand_in_order<Dim>(
       items.size(),
@@ -373,9 +389,8 @@ template <int Dim> Orthtree<Dim> refine(const Orthtree<Dim>& t, const Flags& fla
                        std::to_string(max_level<Dim>));
     }
   }
-  std::vector<Cell<Dim>> out;
+  LeafVector<Dim> out;
   out.reserve(t.n_leaves() + n_flagged * (Cube<Dim>::n_children - 1));
-  advise_huge_pages(out.data(), out.capacity() * sizeof(Cell<Dim>));
   for (std::size_t i = 0; i < flags.size(); ++i) {
     if (flags[i]) {
       for (int k = 0; k < Cube<Dim>::n_children; ++k) out.push_back(make_child(t.leaf(i), k));

@@ -61,6 +61,17 @@ template <int Dim> ControlFn<Dim> sphere_control(double r, int k) {
   };
 }
 
+/// The 1-minute load average: with 2 cores, a load above ~1 before a run means another process
+/// competed for the second core, and the 2-thread columns then understate the speedup.
+double load_average() {
+  double load = -1.0;
+  if (std::FILE* f = std::fopen("/proc/loadavg", "r")) {
+    if (std::fscanf(f, "%lf", &load) != 1) load = -1.0;
+    std::fclose(f);
+  }
+  return load;
+}
+
 /// Memory cost of one operation: the growth of the peak resident set while it runs, from the
 /// resident set just before it (the peak is reset first). Free heap memory is returned to the
 /// system first, or the operation could reuse pages that are already counted in the base.
@@ -104,7 +115,7 @@ template <int Dim> void run(int k, int reps, const std::string& csv_path, int pi
 
   // Serial refinement; the last repetition also gives its memory peak (the earlier ones have
   // paged in the code, which is not the refinement's memory).
-  Best refine1, refine2, balance1;
+  Best refine1, refine2, balance1, balance2;
   double refine_peak = 0.0;
   std::uint64_t serial_sum = 0;
   for (int r = 0; r < reps; ++r) {
@@ -148,16 +159,31 @@ template <int Dim> void run(int k, int reps, const std::string& csv_path, int pi
     }
   }
 
+  // The same balance on two threads: identical leaves, and how much faster.
+  BalanceOptions bopt2;
+  bopt2.n_threads = 2;
+  const std::uint64_t balanced_sum = checksum(balance_2to1(tree, BalanceKind::Face));
+  for (int r = 0; r < reps; ++r) {
+    const Stopwatch watch;
+    const Orthtree<Dim> balanced = balance_2to1(tree, BalanceKind::Face, bopt2);
+    balance2.add(watch);
+    if (checksum(balanced) != balanced_sum) {
+      std::cerr << "parallel balance differs from serial\n";
+      std::exit(1);
+    }
+  }
+
   const double n = double(tree.n_leaves()), nb = double(n_balanced);
-  std::printf("%dD %3d %10zu %7.1f %7.1f %7.1f %6.2f %7.1f | %10zu %7.1f %7.1f %7.1f %7.1f\n", Dim, k,
-              tree.n_leaves(), 1e-6 * n / refine1.cpu, 1e-6 * n / refine1.wall, 1e-6 * n / refine2.wall,
+  std::printf("%dD %3d %10zu %7.1f %7.1f %7.1f %6.2f %7.1f | %10zu %7.1f %7.1f %7.1f %6.2f %7.1f %7.1f | %5.2f\n",
+              Dim, k, tree.n_leaves(), 1e-6 * n / refine1.cpu, 1e-6 * n / refine1.wall, 1e-6 * n / refine2.wall,
               refine1.wall / refine2.wall, refine_peak / n, n_balanced, 1e-6 * nb / balance1.cpu,
-              1e-6 * nb / balance1.wall, balance_peak / nb, container);
+              1e-6 * nb / balance1.wall, 1e-6 * nb / balance2.wall, balance1.wall / balance2.wall,
+              balance_peak / nb, container, load_average());
   std::fflush(stdout);
   std::ofstream csv(csv_path, std::ios::app);
   csv << Dim << ',' << k << ',' << tree.n_leaves() << ',' << refine1.wall << ',' << refine1.cpu << ','
       << refine2.wall << ',' << refine_peak << ',' << n_balanced << ',' << balance1.wall << ',' << balance1.cpu
-      << ',' << balance_peak << ',' << container * nb << '\n';
+      << ',' << balance2.wall << ',' << balance_peak << ',' << container * nb << ',' << load_average() << '\n';
   const std::uint64_t count = n_balanced;
   if (write(pipe_fd, &count, sizeof count) != ssize_t(sizeof count)) std::exit(1);
 }
@@ -193,17 +219,19 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories("results");
   const std::string csv = "results/bench_tree.csv";
   std::ofstream(csv) << "dim,level,leaves,refine_s,refine_cpu_s,refine_2threads_s,refine_peak_bytes,"
-                        "balanced_leaves,balance_s,balance_cpu_s,balance_peak_bytes,balanced_container_bytes\n";
+                        "balanced_leaves,balance_s,balance_cpu_s,balance_2threads_s,balance_peak_bytes,balanced_container_bytes,"
+                        "load_1min\n";
 
   std::printf("stored bytes per leaf: sizeof(Cell<2>) = %zu, sizeof(Cell<3>) = %zu\n", sizeof(Cell<2>),
               sizeof(Cell<3>));
   std::printf("rates: leaves per second, best of %d runs, of CPU time and of wall-clock time (one thread);\n"
               "2thr: wall-clock rate on two threads (same checksum as serial), x = speedup over one thread.\n"
+              "load: 1-minute load average after the size (other processes; speedups need it near 0).\n"
               "B/leaf: growth of the peak resident set during the operation over the leaves it made\n"
               "(balance: the input tree is resident before and not counted); cont: the balanced tree's\n"
               "own vector (capacity x sizeof) per leaf.\n\n",
               reps);
-  std::printf("   k     leaves  refine    wall    2thr      x  B/leaf |   balanced balance    wall  B/leaf    cont\n");
+  std::printf("   k     leaves  refine    wall    2thr      x  B/leaf |   balanced balance    wall    2thr      x  B/leaf    cont |  load\n");
   std::fflush(stdout);
 
   // A band around a curve holds about c 2^k leaves in 2D and c 4^k in 3D: each step of k

@@ -2,6 +2,9 @@
 // with the textbook ripple algorithm (split any leaf with a neighbour two levels finer, repeat
 // until nothing changes), whose every split is forced, so it yields the coarsest balanced tree.
 
+#include <algorithm>
+#include <cmath>
+
 #include <catch2/catch.hpp>
 
 #include "core/cell_arbitrary.hpp"
@@ -61,11 +64,11 @@ TEMPLATE_TEST_CASE_SIG("invariants catch broken trees", "[orthtree][invariants]"
   // Built by hand without the constructor's Debug check: a tree missing a leaf, one with a
   // duplicate, one unsorted, one with an overlap.
   auto leaves = t.leaves();
-  const auto check = [](const std::vector<Cell<Dim>>& cells, bool sorted_linear, bool complete) {
+  const auto check = [](const LeafVector<Dim>& cells, bool sorted_linear, bool complete) {
     // The constructor asserts completeness in Debug builds, so plant the broken leaves into a
     // (non-const) tree directly.
     Orthtree<Dim> tree;
-    const_cast<std::vector<Cell<Dim>>&>(tree.leaves()) = cells;
+    const_cast<LeafVector<Dim>&>(tree.leaves()) = cells;
     CHECK(is_sorted_and_linear(tree) == sorted_linear);
     CHECK(is_sorted_and_linear_ref(tree) == sorted_linear);
     CHECK(is_complete(tree) == complete);
@@ -176,4 +179,54 @@ TEMPLATE_TEST_CASE_SIG("balance refuses results beyond the leaf limit", "[orthtr
   // An input already beyond the limit is refused before any work.
   opt.max_leaves = t.n_leaves() - 1;
   REQUIRE_THROWS_AS(balance_2to1(t, BalanceKind::Full, opt), LimitError);
+}
+
+TEMPLATE_TEST_CASE_SIG("parallel balance equals serial", "[orthtree][balance]", ((int Dim), Dim), 2, 3) {
+  // A band of fine cells around a sphere, graded by nothing: large enough that every level's
+  // candidates are cut into pieces (4096 or more internal cells) and the final walk is cut
+  // into many subtrees at a split level below the root.
+  const double r = 0.35;
+  const int k = Dim == 2 ? 12 : 7;
+  const ControlFn<Dim> control = [r, k](const Box<Dim>& b) {
+    const Point<Dim> c = Point<Dim>::Constant(0.5);
+    const double near = (c.cwiseMax(b.lo).cwiseMin(b.hi) - c).norm();
+    Point<Dim> far;
+    for (int d = 0; d < Dim; ++d) far[d] = std::max(std::abs(b.lo[d] - c[d]), std::abs(b.hi[d] - c[d]));
+    return near <= r && far.norm() >= r ? double(k) : 0.0;
+  };
+  const Box<Dim> unit{Point<Dim>::Zero(), Point<Dim>::Ones()};
+  const auto t = subdivide_by_control<Dim>(unit, control);
+  REQUIRE(t.n_leaves() > 20000);
+  for (const auto kind : {BalanceKind::Face, BalanceKind::Full}) {
+    const auto serial = balance_2to1(t, kind);
+    REQUIRE(serial.n_leaves() > t.n_leaves());
+    REQUIRE(is_complete(serial));
+    REQUIRE(is_balanced(serial, kind));
+    REQUIRE(serial.leaves().capacity() == serial.n_leaves());
+    for (const int threads : {2, 3, 4}) {
+      BalanceOptions opt;
+      opt.n_threads = threads;
+      INFO("threads " << threads);
+      REQUIRE(balance_2to1(t, kind, opt).leaves() == serial.leaves());
+    }
+  }
+  // The limit holds on several threads too.
+  BalanceOptions opt;
+  opt.n_threads = 2;
+  opt.max_leaves = balance_2to1(t).n_leaves() - 1;
+  REQUIRE_THROWS_AS(balance_2to1(t, BalanceKind::Face, opt), LimitError);
+}
+
+TEMPLATE_TEST_CASE_SIG("parallel balance equals serial on random trees", "[orthtree][balance][property]", ((int Dim), Dim), 2, 3) {
+  test::prop("balance_2to1 with 2 and 3 threads", 40, [] {
+    const auto t = (*test::gen_recipe<Dim>()).build();
+    for (const auto kind : {BalanceKind::Face, BalanceKind::Full}) {
+      const auto serial = balance_2to1(t, kind);
+      for (const int threads : {2, 3}) {
+        BalanceOptions opt;
+        opt.n_threads = threads;
+        RC_ASSERT(balance_2to1(t, kind, opt).leaves() == serial.leaves());
+      }
+    }
+  });
 }

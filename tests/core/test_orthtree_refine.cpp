@@ -143,9 +143,9 @@ TEMPLATE_TEST_CASE_SIG("mark, refine and refine_while", "[orthtree][refine]", ((
 }
 
 TEMPLATE_TEST_CASE_SIG("large refinements span many storage blocks, threads agree", "[orthtree][refine]", ((int Dim), Dim), 2, 3) {
-  // Uniform level 8 (2D, 65536 leaves) or 6 (3D, 262144 leaves): several of the spool's blocks
-  // per thread, drained in order into the tree.
-  constexpr int level = Dim == 2 ? 8 : 6;
+  // Uniform level 10 (2D, 1Mi leaves) or 7 (3D, 2Mi leaves): several of the spool's blocks
+  // (256 Ki leaves each) per thread, drained in order into the tree.
+  constexpr int level = Dim == 2 ? 10 : 7;
   const Box<Dim> unit{Point<Dim>::Zero(), Point<Dim>::Ones()};
   const auto control = [](const Box<Dim>&) { return double(level); };
   RefineOptions opt;
