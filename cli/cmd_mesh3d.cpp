@@ -62,6 +62,19 @@ nlohmann::json quality_json(const QualitySummary& q) {
   return j;
 }
 
+/// The mesh with each interface quad split into two triangles: measure_fidelity samples
+/// triangles only (hex-dominant BE meshes have quads).
+Mesh<3> triangulated_interface(const Mesh<3>& m) {
+  Mesh<3> out = m;
+  out.interface.clear();
+  for (std::size_t f = 0; f < m.interface.size(); ++f) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    out.interface.add(ElemType::Tri3, {v[0], v[1], v[2]});
+    if (m.interface.type[f] == ElemType::Quad4) out.interface.add(ElemType::Tri3, {v[0], v[2], v[3]});
+  }
+  return out;
+}
+
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--allow-invalid"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth"});
@@ -98,7 +111,7 @@ int run(const std::vector<std::string>& argv) {
   vo.boundary_tolerance = 1e-10 * surface.bounding_box().extent().norm();
   const ValidationReport vr = validate(mesh, vo);
   const QualitySummary q = summarize_quality(mesh);
-  const dim3::Fidelity3d fid = dim3::measure_fidelity(mesh, surface);
+  const dim3::Fidelity3d fid = dim3::measure_fidelity(opt.hex_dominant ? triangulated_interface(mesh) : mesh, surface);
   const double t_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - tv).count();
 
   if (!vr.valid && !args.has("--allow-invalid"))

@@ -183,14 +183,22 @@ template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>>
     default: break;
   }
   if constexpr (Dim == 3) {
-    // Divergence theorem over the (triangulated) faces, relative to the first node.
+    // Divergence theorem over the (triangulated) faces, relative to the first node. A quad face
+    // counts as the mean of its two diagonal splits: a non-planar quad shared by two elements
+    // (hex-dominant meshes) then cancels exactly, as it does in interface_enclosed_measure.
     double v = 0.0;
     for (int f = 0; f < n_facets(t); ++f) {
       const auto local = facet_local_nodes(t, f);
-      for (std::size_t i = 1; i + 1 < local.size(); ++i) {
-        const Point<3> a = p[local[0]] - p[0], b = p[local[i]] - p[0], c = p[local[i + 1]] - p[0];
-        v += a.dot(b.cross(c));
-      }
+      const auto fan = [&](std::size_t s) {
+        double w = 0.0;
+        for (std::size_t i = 1; i + 1 < local.size(); ++i) {
+          const Point<3> a = p[local[s]] - p[0], b = p[local[(s + i) % local.size()]] - p[0],
+                         c = p[local[(s + i + 1) % local.size()]] - p[0];
+          w += a.dot(b.cross(c));
+        }
+        return w;
+      };
+      v += local.size() == 4 ? 0.5 * (fan(0) + fan(1)) : fan(0);
     }
     return v / 6.0;
   } else {
@@ -307,10 +315,14 @@ template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh) {
       const Point<2> a = mesh.points[n[0].v] - o, b = mesh.points[n[1].v] - o;
       m += 0.5 * (a.x() * b.y() - a.y() * b.x());
     } else {
-      const Point<3> a = mesh.points[n[0].v] - o;
-      for (int i = 1; i + 1 < k; ++i) {
-        const Point<3> b = mesh.points[n[i].v] - o, c = mesh.points[n[i + 1].v] - o;
-        m += a.dot(b.cross(c)) / 6.0;
+      // A quad as the mean of its two diagonal splits (as signed_measure counts element faces).
+      const int n_fans = k == 4 ? 2 : 1;
+      for (int s = 0; s < n_fans; ++s) {
+        const Point<3> a = mesh.points[n[s].v] - o;
+        for (int i = 1; i + 1 < k; ++i) {
+          const Point<3> b = mesh.points[n[(s + i) % k].v] - o, c = mesh.points[n[(s + i + 1) % k].v] - o;
+          m += a.dot(b.cross(c)) / (6.0 * n_fans);
+        }
       }
     }
   }

@@ -42,6 +42,24 @@ std::optional<Ring4> plain_square(const LatticeNodes<3>& lattice, const std::arr
   return r;
 }
 
+/// The plain quads of a square face, by the template face rule (triangulate_square): a square
+/// with a lattice node at its centre is its four sub-squares, each by the rule; a square with
+/// lattice nodes at edge midpoints is fanned (no quad). In the order of `q`.
+void plain_squares(const LatticeNodes<3>& lattice, const std::array<LP, 4>& q, std::uint32_t len,
+                   std::vector<Ring4>& out) {
+  if (len >= 2 && lattice.find(midpoint(q[0], q[2])) >= 0) {
+    const LP x = midpoint(q[0], q[2]), m01 = midpoint(q[0], q[1]), m12 = midpoint(q[1], q[2]),
+             m23 = midpoint(q[2], q[3]), m30 = midpoint(q[3], q[0]);
+    const std::uint32_t h = len / 2;
+    plain_squares(lattice, {q[0], m01, x, m30}, h, out);
+    plain_squares(lattice, {m01, q[1], m12, x}, h, out);
+    plain_squares(lattice, {x, m12, q[2], m23}, h, out);
+    plain_squares(lattice, {m30, x, m23, q[3]}, h, out);
+    return;
+  }
+  if (const auto r = plain_square(lattice, q, len)) out.push_back(*r);
+}
+
 /// A plain quad face of one cell: outward ring (counter-clockwise seen from outside the cell),
 /// the global face it is, and the cell's two cones that cover it.
 struct QuadFace {
@@ -138,13 +156,15 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     if (ci.cones.empty()) continue;
     const Cell<3>& c = t.leaf(oc.interior[k]);
     int n_plain = 0;
+    std::vector<Ring4> quads;
     for (int f = 0; f < Cube<3>::n_faces; ++f) {
       const auto& fc = FaceCorners<3>::corners[f];
-      const auto r = plain_square(oc.lattice, {corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])},
-                                  length(c));
-      if (!r) continue;
-      ++n_plain;
-      add_quad(m, ci, faces, *r, false);
+      const std::array<LP, 4> q{corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])};
+      if (plain_square(oc.lattice, q, length(c))) ++n_plain;
+      // Sub-squares against finer octants are quads too: pyramids from this cell's centroid.
+      quads.clear();
+      plain_squares(oc.lattice, q, length(c), quads);
+      for (const Ring4& r : quads) add_quad(m, ci, faces, r, false);
     }
     if (n_plain == Cube<3>::n_faces) {
       // Gmsh order: corners 0 1 3 2 (z low, counter-clockwise seen from above), then above them.
@@ -165,14 +185,13 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     for (std::size_t i = 0; i < n; ++i) p[i] = oc.projection[bo.ring[i]];
     int n_plain = 0;
     const auto& fc = FaceCorners<3>::corners[bo.face];
-    const auto q = plain_square(
-        oc.lattice, {corner(bo.cell, fc[0]), corner(bo.cell, fc[1]), corner(bo.cell, fc[2]), corner(bo.cell, fc[3])},
-        length(bo.cell));
-    if (q) {
-      // Seen from the boundary octant, the interior octant's face turns the other way.
-      add_quad(m, ci, faces, {(*q)[0], (*q)[3], (*q)[2], (*q)[1]}, false);
-      ++n_plain;
-    }
+    const std::array<LP, 4> sq{corner(bo.cell, fc[0]), corner(bo.cell, fc[1]), corner(bo.cell, fc[2]),
+                               corner(bo.cell, fc[3])};
+    if (plain_square(oc.lattice, sq, length(bo.cell))) ++n_plain;
+    std::vector<Ring4> quads;
+    plain_squares(oc.lattice, sq, length(bo.cell), quads);
+    // Seen from the boundary octant, the interior octant's face turns the other way.
+    for (const Ring4& q : quads) add_quad(m, ci, faces, {q[0], q[3], q[2], q[1]}, false);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t j = (i + 1) % n;
       const Ring4 side{bo.ring[i], bo.ring[j], p[j], p[i]};
