@@ -177,14 +177,36 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   if (deepest <= 1) return t;  // children of the root are always balanced
 
   // internal[L]: sorted Morton keys of internal cells at level L. Parents of the leaves come out
-  // sorted from the Morton-ordered leaves (masking low bits is monotone).
-  std::vector<std::vector<std::uint64_t>> internal(deepest);
-  for (const auto& c : leaves) {
-    if (c.level == 0) continue;
-    const int pl = c.level - 1;
-    const std::uint64_t pk = detail::interleave<Dim>(c.anchor) & ~((std::uint64_t(1) << (Dim * (max_level<Dim> - pl))) - 1);
-    auto& v = internal[pl];
-    if (v.empty() || v.back() != pk) v.push_back(pk);
+  // sorted from the Morton-ordered leaves (masking low bits is monotone). On several threads
+  // each takes a contiguous part of the leaves; the parts' lists are concatenated in order,
+  // where only a parent straddling two parts can repeat.
+  const int n_threads = std::max(1, opt.n_threads);
+  const int n_parts = leaves.size() < 65536 ? 1 : n_threads;
+  std::vector<std::vector<std::vector<std::uint64_t>>> parts(
+      static_cast<std::size_t>(n_parts), std::vector<std::vector<std::uint64_t>>(static_cast<std::size_t>(deepest)));
+  on_threads(n_parts, [&](int t) {
+    auto& mine = parts[std::size_t(t)];
+    const std::size_t begin = leaves.size() * std::size_t(t) / std::size_t(n_parts);
+    const std::size_t end = leaves.size() * std::size_t(t + 1) / std::size_t(n_parts);
+    for (std::size_t i = begin; i < end; ++i) {
+      const Cell<Dim>& c = leaves[i];
+      if (c.level == 0) continue;
+      const int pl = c.level - 1;
+      const std::uint64_t pk =
+          detail::interleave<Dim>(c.anchor) & ~((std::uint64_t(1) << (Dim * (max_level<Dim> - pl))) - 1);
+      auto& v = mine[std::size_t(pl)];
+      if (v.empty() || v.back() != pk) v.push_back(pk);
+    }
+  });
+  std::vector<std::vector<std::uint64_t>> internal = std::move(parts[0]);
+  for (std::size_t t = 1; t < parts.size(); ++t) {
+    for (int level = 0; level < deepest; ++level) {
+      auto& v = internal[std::size_t(level)];
+      auto& more = parts[t][std::size_t(level)];
+      const std::size_t skip = !v.empty() && !more.empty() && more.front() == v.back() ? 1 : 0;
+      v.insert(v.end(), more.begin() + std::ptrdiff_t(skip), more.end());
+      std::vector<std::uint64_t>().swap(more);
+    }
   }
   MESH_ASSERT(std::all_of(internal.begin(), internal.end(),
                           [](const auto& v) { return std::is_sorted(v.begin(), v.end()); }),
@@ -200,7 +222,6 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   };
   check_limit(false);
 
-  const int n_threads = std::max(1, opt.n_threads);
   {
     std::vector<std::vector<std::uint64_t>> candidates(static_cast<std::size_t>(n_threads));
     std::vector<std::uint64_t> merged;
