@@ -61,6 +61,11 @@ P3 centroid(const Mesh<3>& m, std::size_t e) {
   return c / pts.n;
 }
 
+P3 face_centroid(const Mesh<3>& m, std::size_t f) {
+  const VertexId* n = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+  return (m.points[n[0].v] + m.points[n[1].v] + m.points[n[2].v]) / 3.0;
+}
+
 double signed_volume(const P3& a, const P3& b, const P3& c, const P3& d) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
 }
@@ -160,6 +165,24 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
   return moved;
 }
 
+/// Interface triangles folded over on the surface: their normal points against the surface's
+/// (the sum of the normals of the surface triangles their nodes lie on). Positive tetrahedra do
+/// not exclude this: a surface node can slide over its neighbours, and the mesh then covers a
+/// strip twice (the validator sees its nodes on other elements' facets).
+std::vector<std::size_t> folded_faces(const Mesh<3>& m, const std::vector<BoundaryLocation>& where,
+                                      const SurfaceBoundary& s) {
+  std::vector<std::size_t> out;
+  for (std::size_t f = 0; f < m.interface.size(); ++f) {
+    const VertexId* n = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    const P3 &a = m.points[n[0].v], &b = m.points[n[1].v], &c = m.points[n[2].v];
+    P3 ref = P3::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (where[n[k].v].patch >= 0) ref += s.surface().normal(where[n[k].v].patch);
+    if (surface_alignment(a, b, c, ref) <= 1e-9) out.push_back(f);
+  }
+  return out;
+}
+
 /// Nodes the optimisation must not move: feature corners, and with `features` the nodes
 /// snapped onto feature lines too.
 std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe, bool features) {
@@ -199,6 +222,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   const SurfacePointFn surface_point = [&](const P3& p) {
     const ClosestPoint<3> cp = s.closest_point(p);
     return std::make_pair(P3(cp.point), cp.where);
+  };
+  const std::function<P3(const BoundaryLocation&)> surface_normal = [&](const BoundaryLocation& w) {
+    return w.patch >= 0 ? s.surface().normal(w.patch) : P3(P3::Zero());
   };
 
   std::vector<P3> peel_points;
@@ -240,24 +266,32 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
           to.max_sweeps = opt.untangle_sweeps;
           to.fixed = fixed_nodes(oc.complex, fe, false);
           to.project = surface_point;
+          to.surface_normal = surface_normal;
           const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
           r.n_untangle_moves += ts.moves;
+          say("untangling: inverted tetrahedra " + std::to_string(ts.inverted_before) + " -> " +
+              std::to_string(ts.inverted_after) + ", folded interface triangles " + std::to_string(ts.folded_before) +
+              " -> " + std::to_string(ts.folded_after));
         }
         const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
+        const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s);
         std::set<std::int32_t> revert;
-        for (std::size_t e : bad) {
-          const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
-          for (int k = 0; k < fe.mesh.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}); ++k) {
+        const auto revert_snapped = [&](const Elements& elems, std::size_t e) {
+          const VertexId* v = elems.nodes(ElemId{static_cast<std::int32_t>(e)});
+          for (int k = 0; k < elems.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}); ++k) {
             const std::int32_t id = v[k].v;
             if (id < static_cast<std::int32_t>(oc.complex.snapped.size()) && oc.complex.snapped[id]) revert.insert(id);
           }
-        }
-        if (bad.empty()) break;
+        };
+        for (std::size_t e : bad) revert_snapped(fe.mesh.solid, e);
+        for (std::size_t f : folded) revert_snapped(fe.mesh.interface, f);
+        if (bad.empty() && folded.empty()) break;
         if (revert.empty()) {
           const std::size_t moved = round < opt.untangle_rounds + 4 ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
           r.n_untangled += moved;
           if (moved == 0) {
             for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
+            for (std::size_t f : folded) problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
             break;
           }
           continue;
@@ -288,12 +322,15 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
         to.target_dihedral_deg = opt.target_dihedral_deg;
         to.fixed = fixed_nodes(oc.complex, fe, true);
         to.project = surface_point;
+        to.surface_normal = surface_normal;
         const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
         r.n_optimize_moves = ts.moves;
       }
       clock.lap("smoothing");
       for (std::size_t e : inverted_elements(fe.mesh))
         problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});
+      for (std::size_t f : folded_faces(fe.mesh, fe.where, s))
+        problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds after smoothing"});
     }
     if (problems.empty()) {
       if (opt.hex_dominant) {

@@ -49,6 +49,29 @@ struct Optimizer {
   std::vector<Tet> tets;
   std::vector<std::int32_t> start, incident;  // CSR node -> tets
   std::vector<std::int32_t> nb_start, nbs;    // CSR node -> neighbour nodes
+  std::vector<std::array<std::int32_t, 3>> faces;  // interface triangles
+  std::vector<std::int32_t> f_start, f_incident;   // CSR node -> interface triangles
+  std::vector<P3> node_normal;                     // surface normal at each surface node
+
+  /// Search quality of interface triangle f with node v at x (normal nx there): +inf when it
+  /// is aligned with the surface, else like an inverted tetrahedron (-1 + cosine, in [-2, -1]).
+  double face_quality(std::int32_t f, std::int32_t v, const P3& x, const P3& nx) const {
+    std::array<P3, 3> p;
+    P3 ref = P3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t u = faces[f][k];
+      p[k] = u == v ? x : mesh.points[u];
+      ref += u == v ? nx : node_normal[u];
+    }
+    const double c = surface_alignment(p[0], p[1], p[2], ref);
+    return c > 1e-9 ? std::numeric_limits<double>::infinity() : -2.0 + 0.5 * (1.0 + c);
+  }
+  double faces_worst(std::int32_t v, const P3& x, const P3& nx) const {
+    double w = std::numeric_limits<double>::infinity();
+    if (f_start.empty()) return w;
+    for (std::int32_t k = f_start[v]; k < f_start[v + 1]; ++k) w = std::min(w, face_quality(f_incident[k], v, x, nx));
+    return w;
+  }
 
   double quality_at(std::int32_t t, std::int32_t v, const P3& x) const {
     std::array<P3, 4> p;
@@ -99,7 +122,9 @@ struct Optimizer {
   bool relax(std::int32_t v) {
     const P3 x0 = mesh.points[v];
     std::int32_t worst_tet = -1;
-    const double f0 = worst_at(v, x0, &worst_tet);
+    const bool surf = is_surface(v);
+    const bool guard = surf && !f_start.empty();
+    const double f0 = std::min(worst_at(v, x0, &worst_tet), guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
     if (opt.untangle_only ? f0 > 0 : f0 >= opt.target_dihedral_deg * pi / 180.0) return false;
     double len = 0.0;
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) len += (mesh.points[nbs[k]] - x0).norm();
@@ -131,7 +156,6 @@ struct Optimizer {
     for (const P3& d : dirs)
       for (double s : {0.25, 0.08, 0.025, 0.006}) cands.push_back(x0 + s * len * d);
 
-    const bool surf = is_surface(v);
     double best = f0;
     P3 best_x = x0;
     BoundaryLocation best_w = surf ? where[v] : BoundaryLocation{};
@@ -139,12 +163,14 @@ struct Optimizer {
       P3 x = c;
       BoundaryLocation w;
       if (surf) std::tie(x, w) = opt.project(c);
-      const double f = worst_above(v, x, best + 1e-12);
+      double f = worst_above(v, x, best + 1e-12);
+      if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w;
     }
     if (best_x == x0) return false;
     mesh.points[v] = best_x;
     if (surf) where[v] = best_w;
+    if (guard) node_normal[v] = opt.surface_normal(best_w);
     return true;
   }
 };
@@ -157,12 +183,18 @@ double tet_search_quality(const P3& a, const P3& b, const P3& c, const P3& d) {
   return std::acos(max_dihedral_cos(a, b, c, d));
 }
 
+double surface_alignment(const P3& a, const P3& b, const P3& c, const P3& ref) {
+  const P3 n = (b - a).cross(c - a);
+  const double len = n.norm() * ref.norm();
+  return len > 0 ? n.dot(ref) / len : -1.0;
+}
+
 double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) {
   return std::acos(max_dihedral_cos(a, b, c, d)) * 180.0 / pi;
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -194,6 +226,30 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     }
   }
 
+  if (opt.surface_normal && opt.project) {
+    o.node_normal.assign(n, P3::Zero());
+    for (std::size_t v = 0; v < n && v < where.size(); ++v)
+      if (where[v].patch >= 0) o.node_normal[v] = opt.surface_normal(where[v]);
+    o.f_start.assign(n + 1, 0);
+    for (std::size_t f = 0; f < mesh.interface.size(); ++f) {
+      const VertexId* v = mesh.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+      if (mesh.interface.n_nodes_of(ElemId{static_cast<std::int32_t>(f)}) != 3) continue;
+      o.faces.push_back({v[0].v, v[1].v, v[2].v});
+      for (int k = 0; k < 3; ++k) ++o.f_start[v[k].v + 1];
+    }
+    for (std::size_t v = 0; v < n; ++v) o.f_start[v + 1] += o.f_start[v];
+    o.f_incident.resize(o.f_start[n]);
+    std::vector<std::int32_t> fill(o.f_start.begin(), o.f_start.end() - 1);
+    for (std::size_t f = 0; f < o.faces.size(); ++f)
+      for (std::int32_t v : o.faces[f]) o.f_incident[fill[v]++] = static_cast<std::int32_t>(f);
+  }
+  const auto count_folded = [&] {
+    std::size_t k = 0;
+    for (std::size_t f = 0; f < o.faces.size(); ++f)
+      if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0) ++k;
+    return k;
+  };
+
   TetOptimizeStats st;
   const auto measure = [&](std::size_t& inverted, double& min_deg) {
     inverted = 0;
@@ -210,6 +266,7 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     }
   };
   measure(st.inverted_before, st.min_dihedral_before_deg);
+  st.folded_before = count_folded();
 
   // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
   const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
@@ -219,6 +276,9 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     if (opt.untangle_only ? q <= 0 : q < target)
       for (std::int32_t v : t) active[v] = 1;
   }
+  for (std::size_t f = 0; f < o.faces.size(); ++f)
+    if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0)
+      for (std::int32_t v : o.faces[f]) active[v] = 1;
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
     std::vector<std::uint8_t> next(n, 0);
     std::size_t moved = 0;
@@ -235,6 +295,7 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     active.swap(next);
   }
   measure(st.inverted_after, st.min_dihedral_after_deg);
+  st.folded_after = count_folded();
   return st;
 }
 

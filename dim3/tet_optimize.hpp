@@ -35,12 +35,19 @@ struct TetOptimizeOptions {
   SurfaceProjection project;
   /// Only untangle: stop a node as soon as its tetrahedra are all positive.
   bool untangle_only = false;
+  /// Outward unit normal of the surface at a location. With it, the interface triangles of a
+  /// surface node count among its elements: one whose normal points against the surface's
+  /// (the sum at its three nodes) is folded, ranked like an inverted tetrahedron. Positive
+  /// tetrahedra alone let a surface node slide over its neighbours, and the mesh then covers
+  /// a strip twice.
+  std::function<Point<3>(const BoundaryLocation&)> surface_normal;
 };
 
 struct TetOptimizeStats {
   int sweeps = 0;
   std::size_t moves = 0;
-  std::size_t inverted_before = 0, inverted_after = 0;
+  std::size_t inverted_before = 0, inverted_after = 0;  ///< tetrahedra
+  std::size_t folded_before = 0, folded_after = 0;      ///< interface triangles (with surface_normal)
   double min_dihedral_before_deg = 0.0, min_dihedral_after_deg = 0.0;
 };
 
@@ -51,6 +58,10 @@ double tet_search_quality(const Point<3>& a, const Point<3>& b, const Point<3>& 
 
 /// Smallest dihedral angle of a tetrahedron in degrees (0 when flat); sign-free.
 double tet_min_dihedral_deg(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
+
+/// Orientation of an interface triangle against the surface: the cosine between its normal and
+/// `ref` (1 = aligned), -1 when it is degenerate.
+double surface_alignment(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& ref);
 
 /// Optimises mesh.points in place (the solid must be all Tet4); `where` (one per node) is
 /// updated for surface nodes that move.
