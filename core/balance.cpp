@@ -15,6 +15,7 @@
 // threads write their parts of the result directly. The result is the same for any thread count.
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <exception>
@@ -101,11 +102,42 @@ template <class F> void on_threads(int n_threads, const F& f) {
   }
 }
 
+/// For each set of internal children of a parent (bit k = child k), the directions in which the
+/// parent's same-size neighbours are required. A direction is a subset of axes plus a side on
+/// each; it leaves the parent only from a child lying on that side along every axis of the
+/// subset. Tabulated once per balance, so that the per-group work is a short list.
+template <int Dim> struct DirectionTable {
+  static constexpr int nc = Cube<Dim>::n_children;
+  std::vector<std::array<int, Dim>> dirs;
+  std::array<std::uint32_t, (1u << nc) + 1> first{};  // dirs[first[m] .. first[m+1]) for mask m
+
+  explicit DirectionTable(BalanceKind kind) {
+    for (unsigned present = 0; present < (1u << nc); ++present) {
+      first[present] = std::uint32_t(dirs.size());
+      for (int axes = 1; axes < nc; ++axes) {
+        if (!Directions<Dim>::wanted(axes, kind)) continue;
+        for (int signs = 0; signs < nc; ++signs) {
+          if ((signs & ~axes) != 0) continue;
+          bool reachable = false;
+          for (int k = 0; k < nc; ++k) {
+            if (((present >> k) & 1u) && (k & axes) == signs) reachable = true;
+          }
+          if (!reachable) continue;
+          std::array<int, Dim> dir;
+          for (int d = 0; d < Dim; ++d) dir[d] = ((axes >> d) & 1) ? (((signs >> d) & 1) ? 1 : -1) : 0;
+          dirs.push_back(dir);
+        }
+      }
+    }
+    first[1u << nc] = std::uint32_t(dirs.size());
+  }
+};
+
 /// Appends to `out` the parents of the sibling groups in here[begin, end) (internal cells at
 /// `level`) and the same-size neighbours of those parents that the rule requires.
 template <int Dim>
 void append_candidates(const std::vector<std::uint64_t>& here, std::size_t begin, std::size_t end, int level,
-                       BalanceKind kind, std::vector<std::uint64_t>& out) {
+                       const DirectionTable<Dim>& table, std::vector<std::uint64_t>& out) {
   constexpr std::size_t nc = Cube<Dim>::n_children;
   const int pl = level - 1;
   const std::uint64_t parent_mask = ~((std::uint64_t(1) << (Dim * (max_level<Dim> - pl))) - 1);
@@ -119,22 +151,9 @@ void append_candidates(const std::vector<std::uint64_t>& here, std::size_t begin
       present |= 1u << ((here[i] >> child_shift) & (nc - 1));
     }
     out.push_back(pk);
-    // A direction is a subset of axes plus a side on each; it leaves the parent only from a
-    // child lying on that side along every axis of the subset.
-    for (int axes = 1; axes < int(nc); ++axes) {
-      if (!Directions<Dim>::wanted(axes, kind)) continue;
-      for (int signs = 0; signs < int(nc); ++signs) {
-        if ((signs & ~axes) != 0) continue;
-        bool reachable = false;
-        for (int k = 0; k < int(nc); ++k) {
-          if (((present >> k) & 1u) && (k & axes) == signs) reachable = true;
-        }
-        if (!reachable) continue;
-        int dir[Dim];
-        for (int d = 0; d < Dim; ++d) dir[d] = ((axes >> d) & 1) ? (((signs >> d) & 1) ? 1 : -1) : 0;
-        std::uint64_t nk;
-        if (neighbour_key<Dim>(pk, pl, dir, nk)) out.push_back(nk);
-      }
+    for (std::uint32_t j = table.first[present]; j < table.first[present + 1]; ++j) {
+      std::uint64_t nk;
+      if (neighbour_key<Dim>(pk, pl, table.dirs[j].data(), nk)) out.push_back(nk);
     }
   }
 }
@@ -223,6 +242,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   check_limit(false);
 
   {
+    const DirectionTable<Dim> table(kind);
     std::vector<std::vector<std::uint64_t>> candidates(static_cast<std::size_t>(n_threads));
     std::vector<std::uint64_t> merged;
     for (int level = deepest - 1; level >= 1; --level) {
@@ -241,7 +261,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
       on_threads(n_pieces, [&](int t) {
         auto& mine = candidates[std::size_t(t)];
         mine.clear();
-        append_candidates<Dim>(here, cut[std::size_t(t)], cut[std::size_t(t) + 1], level, kind, mine);
+        append_candidates<Dim>(here, cut[std::size_t(t)], cut[std::size_t(t) + 1], level, table, mine);
         std::sort(mine.begin(), mine.end());
         mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
       });
