@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 #include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
@@ -273,6 +274,37 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       });
     }
     i = j;
+  }
+
+  // A quad facet against two triangles on its four nodes (a hex beside two tets) leaves all three
+  // used once, so the grouping above cannot see it, and an interface listing all three would match.
+  {
+    const auto is_boundary = [&](VertexId a, VertexId b, VertexId c) {
+      Facet t;
+      t.type = ElemType::Tri3;
+      t.n = 3;
+      t.node = {a, b, c, VertexId{}};
+      const FacetKey k = key_of(t);
+      return std::binary_search(boundary.begin(), boundary.end(), k,
+                                [](const auto& x, const auto& y) {
+                                  if constexpr (std::is_same_v<std::decay_t<decltype(x)>, FacetKey>) return x < y.key;
+                                  else return x.key < y;
+                                });
+    };
+    for (const FacetUse& q : boundary) {
+      if (q.key.v[3] < 0) continue;
+      const Facet f = facet_of(mesh.solid, q.elem, q.local);
+      for (int d = 0; d < 2; ++d) {
+        const VertexId a = f.node[d], b = f.node[d + 1], c = f.node[(d + 2) % 4], e = f.node[(d + 3) % 4];
+        if (!is_boundary(a, b, c) || !is_boundary(a, c, e)) continue;
+        ++r.nonconforming_facets;
+        problems.add([&](auto& os) {
+          os << "quad facet " << fmt_key(q.key) << " of solid element " << q.elem.v
+             << " meets two triangles on its nodes, at " << fmt<Dim>(pts[q.key.v[0]]);
+        });
+        break;
+      }
+    }
   }
 
   // Interface == boundary facets, same orientation.

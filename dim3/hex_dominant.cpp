@@ -220,8 +220,15 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   for (CellInfo& ci : cells) {
     for (QuadFace& q : ci.quads) {
       const auto ep = points_of(pts, {q.ring[0], q.ring[3], q.ring[2], q.ring[1], ci.apex});
-      q.pyramid_ok = min_corner_jacobian<3>(ElemType::Pyramid5, ep.span()) > 0 &&
-                     scaled_jacobian<3>(ElemType::Pyramid5, ep.span()) > 1e-6;
+      // A pyramid worse than both the threshold and the cones it replaces is not worth it.
+      double cones_sj = 1.0;
+      for (std::size_t e : q.cones) {
+        const auto cp = element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, pts);
+        cones_sj = std::min(cones_sj, scaled_jacobian<3>(ElemType::Tet4, cp.span()));
+      }
+      const double sj = scaled_jacobian<3>(ElemType::Pyramid5, ep.span());
+      q.pyramid_ok = min_corner_jacobian<3>(ElemType::Pyramid5, ep.span()) > 0 && sj > 0 &&
+                     sj >= std::min(opt.min_pyramid_scaled_jacobian, cones_sj);
     }
     if (!ci.candidate) continue;
     ++st.n_hex_candidates;

@@ -16,8 +16,9 @@
 // - any other cell keeps its centroid: each plain quad face becomes a Pyramid5 with the centroid
 //   as apex (the union of its two cones), every other face triangle stays a Tet4;
 // - a quad face is split back into its two triangles, on both sides, when a pyramid on it has a
-//   non-positive corner Jacobian or when it is not seen as a quad by both cells; a hex with a
-//   split face becomes pyramids. Repeated until nothing changes (splits only grow), so every
+//   non-positive corner Jacobian, or a scaled Jacobian below both min_pyramid_scaled_jacobian
+//   and its two cones', or when it is not seen as a quad by both cells; a hex with a split face
+//   becomes pyramids. Repeated until nothing changes (splits only grow), so every
 //   shared face is the same quad or the same two triangles on both sides.
 
 #include <cstddef>
@@ -31,6 +32,8 @@ namespace febemesh::dim3 {
 struct HexDominantOptions {
   /// Cells whose hex would have a lower scaled Jacobian become pyramids and tets instead.
   double min_hex_scaled_jacobian = 0.2;
+  /// A pyramid below this scaled Jacobian and below its two cones' stays two tets.
+  double min_pyramid_scaled_jacobian = 0.2;
 };
 
 struct HexDominantStats {

@@ -77,10 +77,13 @@ TEMPLATE_TEST_CASE_SIG("MSH round trip preserves the mesh", "[msh]", ((int Dim),
 TEST_CASE("MSH round trip of mixed element types", "[msh]") {
   Mesh<3> m;
   using P = Point<3>;
-  for (const P& p : {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0.5, 0.5, 1), P(0.5, 0.5, -1)}) m.add_point(p);
+  for (const P& p : {P(0, 0, 0), P(1, 0, 0), P(1, 1, 0), P(0, 1, 0), P(0.5, 0.5, 1), P(0.5, 0.5, -1), P(1.5, 0.5, 0.5)})
+    m.add_point(p);
+  // Two pyramids on one square (a square against two triangles does not conform) and a tet on
+  // a triangle of the upper one.
   m.solid.add(ElemType::Pyramid5, {VertexId{0}, VertexId{1}, VertexId{2}, VertexId{3}, VertexId{4}});
-  m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{2}, VertexId{1}, VertexId{5}});
-  m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{3}, VertexId{2}, VertexId{5}});
+  m.solid.add(ElemType::Pyramid5, {VertexId{0}, VertexId{3}, VertexId{2}, VertexId{1}, VertexId{5}});
+  m.solid.add(ElemType::Tet4, {VertexId{1}, VertexId{2}, VertexId{4}, VertexId{6}});
   test::set_interface_to_boundary(m);
   REQUIRE(is_valid(m));
   const Mesh<3> back = parse_msh<3>(msh_string(m));

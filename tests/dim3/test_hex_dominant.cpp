@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
 #include "core/read_msh.hpp"
 #include "core/validate.hpp"
@@ -192,4 +193,54 @@ TEST_CASE("mesh3d --elements hex writes a valid mesh.msh with hexes", "[hex_domi
   CHECK(rep["hex_dominant"]["hex_share"].get<double>() > 0.0);
   CHECK(rep["validation"]["valid"].get<bool>());
   std::filesystem::remove_all(out);
+}
+
+// What the hex-dominant mesh relies on the validator for: a quad face against a pyramid's base
+// conforms; the same quad against two triangles (a hex beside two tets) does not; a hex with one
+// corner folded in is inverted although its volume is positive.
+namespace {
+
+/// A unit cube hex and, on its x = 1 face, a pyramid (apex at x = 1.5) or the pyramid's two
+/// tets; the interface is the solid's boundary facets.
+Mesh<3> hex_and_cap(bool split_cap) {
+  Mesh<3> m;
+  for (int k = 0; k < 8; ++k) m.add_point(P3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+  const VertexId apex = m.add_point(P3(1.5, 0.5, 0.5));
+  const auto v = [](int i) { return VertexId{i}; };
+  m.solid.add(ElemType::Hex8, {v(0), v(1), v(3), v(2), v(4), v(5), v(7), v(6)});
+  // x-high face 1 3 7 5 is counter-clockwise seen from outside the hex, that is from the apex:
+  // the pyramid's base in Gmsh order.
+  if (split_cap) {
+    m.solid.add(ElemType::Tet4, {v(1), v(7), v(5), apex});
+    m.solid.add(ElemType::Tet4, {v(1), v(3), v(7), apex});
+  } else {
+    m.solid.add(ElemType::Pyramid5, {v(1), v(3), v(7), v(5), apex});
+  }
+  for (const BoundaryFacet& b : boundary_facets(m.solid))
+    m.interface.add(b.facet.type, b.facet.node.data(), b.facet.n);
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("the validator: quad against pyramid base conforms, against two triangles does not", "[hex_dominant]") {
+  const Mesh<3> good = hex_and_cap(false);
+  for (std::size_t e = 0; e < good.solid.size(); ++e) {
+    const auto p = element_points<3>(good.solid, ElemId{static_cast<std::int32_t>(e)}, good.points);
+    REQUIRE(min_corner_jacobian<3>(good.solid.type[e], p.span()) > 0.0);
+  }
+  const ValidationReport v = validate(good);
+  INFO(v.summary());
+  CHECK(v.valid);
+
+  const Mesh<3> bad = hex_and_cap(true);
+  const ValidationReport w = validate(bad);
+  CHECK_FALSE(w.valid);
+  CHECK(w.nonconforming_facets >= 1);
+
+  Mesh<3> folded = hex_and_cap(false);
+  folded.points[6] = P3(0.3, 0.3, 0.3);  // corner (0, 1, 1) pulled inside: that corner inverts
+  const auto p = element_points<3>(folded.solid, ElemId{0}, folded.points);
+  CHECK(signed_measure<3>(ElemType::Hex8, p.span()) > 0.0);
+  CHECK(validate(folded).inverted >= 1);
 }
