@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <thread>
@@ -69,19 +70,31 @@ class LevelSpool {
     ++size_;
   }
   std::size_t size() const { return size_; }
-  /// Calls f(level) for the leaves [begin, end). Ranges must be drained in increasing order:
-  /// blocks wholly before `end` are unmapped.
-  template <class F> void drain(std::size_t begin, std::size_t end, F&& f) {
+  /// Ends appending: from here on the leaves may be read by several threads, each block being
+  /// unmapped by the reader that consumes its last leaf.
+  void seal() {
+    remaining_ = std::make_unique<std::atomic<std::size_t>[]>(blocks_.size());
+    for (std::size_t b = 0; b < blocks_.size(); ++b) {
+      remaining_[b].store(b + 1 < blocks_.size() ? block_bytes : fill_, std::memory_order_relaxed);
+    }
+  }
+  /// Calls f(level) for the leaves [begin, end) and releases them (after seal(); every leaf is
+  /// read so exactly once).
+  template <class F> void consume(std::size_t begin, std::size_t end, F&& f) {
     while (begin < end) {
       const std::size_t b = begin / block_bytes, stop = std::min(end, (b + 1) * block_bytes);
       const std::uint8_t* block = blocks_[b];
       for (std::size_t i = begin - b * block_bytes, n = stop - b * block_bytes; i < n; ++i) f(block[i]);
-      if (stop == (b + 1) * block_bytes) {
+      if (remaining_[b].fetch_sub(stop - begin, std::memory_order_acq_rel) == stop - begin) {
         munmap(blocks_[b], block_bytes);
         blocks_[b] = nullptr;
       }
       begin = stop;
     }
+  }
+  /// Calls f(level) for the leaves [begin, end) without releasing them (before any consume()).
+  template <class F> void peek(std::size_t begin, std::size_t end, F&& f) const {
+    for (std::size_t i = begin; i < end; ++i) f(blocks_[i / block_bytes][i % block_bytes]);
   }
 
  private:
@@ -99,6 +112,7 @@ class LevelSpool {
   std::vector<std::uint8_t*> blocks_;
   std::size_t fill_ = block_bytes;  // bytes used in the last block
   std::size_t size_ = 0;
+  std::unique_ptr<std::atomic<std::size_t>[]> remaining_;  // per block, leaves not yet consumed
 };
 
 template <int Dim> inline std::uint64_t volume_of_level(int level) {
@@ -226,9 +240,9 @@ template <class F> void on_threads(int n_threads, const F& f) {
 /// contiguous chunks, each chunk's leaves form one range of its thread's spool, and the ranges
 /// are placed in chunk order. Two phases: the threads expand chunks (taken dynamically, in
 /// increasing order), then, with every chunk's size and so its place in the result known, each
-/// thread writes the cells of its own chunks there. Draining its own spool front to back, it
-/// frees the spool's blocks as it goes. Both phases run in parallel: a serial copy into the
-/// result was a third of a refinement (measured) and kept two threads near 1x.
+/// thread writes an equal share of the result, reading whichever spools hold it; a spool block
+/// is unmapped as soon as its last leaf is read. Both phases run in parallel: a serial copy into
+/// the result was a third of a refinement (measured) and kept two threads near 1x.
 template <int Dim, class Work>
 LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
   n_threads = std::max(1, n_threads);
@@ -243,7 +257,6 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
   const std::size_t n_chunks = n_threads == 1 ? std::min<std::size_t>(n_work, 1)
                                               : std::min(n_work, std::size_t(n_threads) * 16);
   std::vector<Range> ranges(n_chunks);
-  std::vector<std::vector<std::size_t>> taken(static_cast<std::size_t>(n_threads));
   std::vector<std::exception_ptr> errors(n_chunks);
   std::atomic<std::size_t> next{0};
   on_threads(n_threads, [&](int t) {
@@ -251,7 +264,6 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
     for (;;) {
       const std::size_t k = next.fetch_add(1);
       if (k >= n_chunks || budget.stop) return;
-      taken[std::size_t(t)].push_back(k);
       Range& range = ranges[k];
       range = {t, out.size(), out.size(), {}};
       try {
@@ -284,21 +296,51 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
 
   std::vector<std::size_t> offset(n_chunks + 1, 0);
   for (std::size_t k = 0; k < n_chunks; ++k) offset[k + 1] = offset[k] + (ranges[k].end - ranges[k].begin);
+  const std::size_t total = offset[n_chunks];
   LeafVector<Dim> out;
-  out.resize(offset[n_chunks]);  // sized, not written (LeafAllocator): the threads write each cell once
+  out.resize(total);  // sized, not written (LeafAllocator): the threads write each cell once
   Cell<Dim>* const cells = out.data();
+  for (auto& spool : spools) spool.seal();
+  // Thread t writes cells [total t / n, total (t + 1) / n): equal shares, whichever thread
+  // expanded them (the expansion balances CPU time, not leaves). A share starting inside a
+  // chunk starts from the chunk's first key plus the volumes of the leaves before it.
+  struct Start {
+    std::size_t chunk = 0, skip = 0;
+    std::uint64_t key = 0;
+  };
+  std::vector<Start> starts(static_cast<std::size_t>(n_threads));
+  for (std::size_t t = 0; t < starts.size(); ++t) {
+    const std::size_t g = total * t / starts.size();
+    if (g >= total) continue;
+    Start& st = starts[t];
+    st.chunk = std::size_t(std::upper_bound(offset.begin(), offset.end(), g) - offset.begin()) - 1;
+    st.skip = g - offset[st.chunk];
+    const Range& r = ranges[st.chunk];
+    st.key = detail::interleave<Dim>(r.first);
+    spools[std::size_t(r.spool)].peek(r.begin, r.begin + st.skip,
+                                      [&](std::uint8_t level) { st.key += volume_of_level<Dim>(level); });
+  }
   on_threads(n_threads, [&](int t) {
-    for (const std::size_t k : taken[std::size_t(t)]) {
+    const std::size_t g0 = total * std::size_t(t) / std::size_t(n_threads);
+    const std::size_t g1 = total * std::size_t(t + 1) / std::size_t(n_threads);
+    if (g0 >= g1) return;
+    Start st = starts[std::size_t(t)];
+    Cell<Dim>* dst = cells + g0;
+    for (std::size_t left = g1 - g0, k = st.chunk; left > 0; ++k) {
       const Range& r = ranges[k];
-      Cell<Dim>* dst = cells + offset[k];
-      std::uint64_t key = detail::interleave<Dim>(r.first);
-      spools[std::size_t(t)].drain(r.begin, r.end, [&](std::uint8_t level) {
+      if (k != st.chunk) {
+        st.skip = 0;
+        st.key = detail::interleave<Dim>(r.first);
+      }
+      const std::size_t n = std::min(left, r.end - r.begin - st.skip);
+      spools[std::size_t(r.spool)].consume(r.begin + st.skip, r.begin + st.skip + n, [&](std::uint8_t level) {
         Cell<Dim> c;
-        c.anchor = detail::deinterleave<Dim>(key);
+        c.anchor = detail::deinterleave<Dim>(st.key);
         c.level = level;
         ::new (static_cast<void*>(dst++)) Cell<Dim>(c);
-        key += volume_of_level<Dim>(level);
+        st.key += volume_of_level<Dim>(level);
       });
+      left -= n;
     }
   });
   return out;
