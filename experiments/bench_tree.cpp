@@ -9,6 +9,10 @@
 // Usage: bench_tree [max_leaves] [repetitions] [dim]   (defaults 1.2e7, 3, both; the largest run
 // stops below max_leaves; times are the best of the repetitions)
 // Output: a table on stdout and results/bench_tree.csv.
+//
+// The two-thread speedups (columns x) mean something only when both cores are free: the last
+// column is the 1-minute load average, and a run beside other processes (load >= 1) shows their
+// share of the cores, not the code's scaling.
 
 #include <algorithm>
 #include <chrono>
