@@ -111,11 +111,15 @@ struct Chain {
 
 }  // namespace
 
-std::size_t remove_pinches(const Orthtree<2>& t, Flags& in) {
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
   std::size_t removed = 0;
+  FreeEdges facets = edges ? std::move(*edges) : free_facets(t, in);
+  bool fresh = true;  // `facets` is free_facets(t, in)
   for (int pass = 0; pass < 64; ++pass) {
+    if (!fresh) facets = free_facets(t, in);
+    fresh = true;
     std::map<LP, int> outgoing;  // ordered: deterministic
-    for (const FreeFacet<2>& f : free_facets(t, in)) ++outgoing[f.corners()[0]];
+    for (const FreeFacet<2>& f : facets) ++outgoing[f.corners()[0]];
     std::vector<std::size_t> drop;
     for (const auto& [p, count] : outgoing) {
       if (count < 2) continue;
@@ -127,18 +131,28 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in) {
       if (in[i]) {
         in[i] = 0;
         ++removed;
+        fresh = false;
       }
     }
   }
+  if (edges) *edges = fresh ? std::move(facets) : free_facets(t, in);
   return removed;
 }
 
-std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction) {
-  if (fraction <= 0) return 0;
+std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
+                         FreeEdges* edges) {
+  if (fraction <= 0) {
+    if (edges) *edges = free_facets(t, in);
+    return 0;
+  }
   std::size_t removed = 0;
+  FreeEdges facets;
+  bool fresh = false;  // `facets` is free_facets(t, in)
   for (int pass = 0; pass < 4; ++pass) {
+    facets = free_facets(t, in);
+    fresh = true;
     std::vector<std::size_t> drop;
-    for (const FreeFacet<2>& f : free_facets(t, in)) {
+    for (const FreeFacet<2>& f : facets) {
       const auto c = f.corners();
       const double h = facet_length(t, f);
       const Point<2> a = position(t, c[0]), b = position(t, c[1]);
@@ -151,12 +165,14 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
     if (drop.empty()) break;
     for (std::size_t i : drop) in[i] = 0;
     removed += drop.size();
+    fresh = false;
   }
+  if (edges) *edges = fresh ? std::move(facets) : free_facets(t, in);
   return removed;
 }
 
 QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& in, const CurveBoundary& curve,
-                                             const BoundaryQuadrantOptions& opt) {
+                                             const BoundaryQuadrantOptions& opt, const FreeEdges* edges) {
   QuadrantComplexResult res;
   QuadrantComplex& qc = res.complex;
   const LatticeNodes<2> nodes = lattice_nodes(t, &in);
@@ -182,7 +198,8 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   }
 
   // Free edges and their chains.
-  const std::vector<FreeFacet<2>> facets = free_facets(t, in);
+  const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
+  const FreeEdges& facets = edges ? *edges : computed;
   res.stats.n_free_edges = facets.size();
   std::vector<std::int32_t> next_facet(nodes.points.size(), -1);
   std::vector<std::array<std::int32_t, 2>> ends(facets.size());

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/free_facets.hpp"
 #include "core/orthtree.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/quadrant_complex.hpp"
@@ -47,13 +48,20 @@ struct QuadrantComplexResult {
   std::vector<Problem> problems;  ///< empty when the complex is complete
 };
 
+/// The free edges of the interior quadrants, passed from one step to the next: each step needs
+/// free_facets(t, in), which costs a neighbour search per face of every interior quadrant.
+using FreeEdges = std::vector<FreeFacet<2>>;
+
 /// Drop interior quadrants so that no two of them meet only at a vertex (a pinch of the
 /// interior region, which would make the boundary chains non-manifold). Returns how many.
-std::size_t remove_pinches(const Orthtree<2>& t, Flags& in);
+/// `edges`, when given, holds free_facets(t, in) on entry and holds it for the new `in` on return.
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges = nullptr);
 
 /// Drop interior quadrants nearer to the curve than `fraction` of their size (the buffer rule
-/// against very thin boundary quadrants). Returns how many.
-std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction);
+/// against very thin boundary quadrants). Returns how many. `edges`, when given, receives
+/// free_facets(t, in) for the new `in`.
+std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
+                         FreeEdges* edges = nullptr);
 
 struct BoundaryQuadrantOptions {
   int max_normals = 4;               ///< local minima tried before walking along the curve
@@ -63,7 +71,8 @@ struct BoundaryQuadrantOptions {
   bool corners_may_fail = false;     ///< at the finest level, leave far corners unpulled
 };
 
+/// `edges`, when given, must be free_facets(t, in) (saves computing it again).
 QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& in, const CurveBoundary& curve,
-                                             const BoundaryQuadrantOptions& opt = {});
+                                             const BoundaryQuadrantOptions& opt = {}, const FreeEdges* edges = nullptr);
 
 }  // namespace febemesh::dim2

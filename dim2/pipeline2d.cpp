@@ -78,14 +78,15 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     const bool last = attempt >= opt.max_repairs;
     say("interior quadrants: classifying " + std::to_string(tree.n_leaves()) + " quadrants");
     Flags in = interior_flags(classify(tree, curve, opt.n_threads));
-    r.n_buffer_dropped = apply_buffer(tree, in, curve, opt.buffer);
-    r.n_pinches_dropped = remove_pinches(tree, in);
+    FreeEdges edges;
+    r.n_buffer_dropped = apply_buffer(tree, in, curve, opt.buffer, &edges);
+    r.n_pinches_dropped = remove_pinches(tree, in, &edges);
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
 
     say("boundary quadrants: projecting the free edges onto the curve");
     BoundaryQuadrantOptions bo;
     bo.corners_may_fail = last;
-    QuadrantComplexResult bq = build_quadrant_complex(tree, in, curve, bo);
+    QuadrantComplexResult bq = build_quadrant_complex(tree, in, curve, bo, &edges);
     clock.lap("boundary quadrants");
     std::vector<Problem> problems = bq.problems;
 
@@ -174,7 +175,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
         r.complex = std::move(bq.complex);
         BoundaryQuadrantOptions no_pull = bo;
         no_pull.pull_corners = false;
-        r.before_pulling = build_quadrant_complex(tree, in, curve, no_pull).complex;
+        r.before_pulling = build_quadrant_complex(tree, in, curve, no_pull, &edges).complex;
       }
       r.interior = std::move(in);
       r.tree = std::move(tree);
