@@ -125,6 +125,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   std::vector<EdgeKey> candidates;
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
   std::vector<std::int32_t> nb;
+  std::vector<double> trial;
   for (int round = 0; round < rounds; ++round) {
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
@@ -215,7 +216,11 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
         if (m.points[v] == saved) break;
         double q = 180.0;
-        for (const std::int32_t e : elems) q = std::min(q, min_corner_angle_deg(m, e));
+        trial.clear();
+        for (const std::int32_t e : elems) {
+          trial.push_back(min_corner_angle_deg(m, e));
+          q = std::min(q, trial.back());
+        }
         if (q > old_q + 1e-12) {
           moved = true;
           break;
@@ -223,7 +228,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
       if (moved) {
         ++st.moves;
-        for (const std::int32_t e : elems) angle[e] = min_corner_angle_deg(m, e);
+        for (std::size_t k = 0; k < elems.size(); ++k) angle[elems[k]] = trial[k];  // the accepted trial's
       } else {
         m.points[v] = saved;
       }

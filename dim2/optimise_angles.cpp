@@ -82,6 +82,15 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q = std::min(q, angle_quality(m, incident[k]));
     return q;
   };
+  // The q of every element, refreshed when one of its nodes moves: most nodes are already
+  // above the target and are skipped on these cached values (the same numbers).
+  std::vector<double> q_elem(n_elems);
+  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = angle_quality(m, e);
+  auto cached_worst = [&](std::size_t v) {
+    double q = 1e300;
+    for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q = std::min(q, q_elem[incident[k]]);
+    return q;
+  };
   // Worst q with node v at p (the node is put back afterwards).
   auto worst_at = [&](std::size_t v, const P2& p) {
     const P2 keep = m.points[v];
@@ -105,7 +114,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       if (first[v] == first[v + 1]) continue;
       const std::uint8_t lock = v < locked.size() ? locked[v] : 0;
       if (lock == 1 || (lock == 2 && !slide)) continue;
-      double best_q = local_worst(v);
+      double best_q = cached_worst(v);
       if (best_q >= opt.target) continue;
       const P2 start = m.points[v];
       // A candidate as the node would really sit there (on the curve for sliding nodes).
@@ -139,6 +148,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       }
       if (best != start) {
         m.points[v] = best;  // (the caller recomputes where sliding nodes lie on the curve)
+        for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q_elem[incident[k]] = angle_quality(m, incident[k]);
         ++st.moves;
         ++moved_this_round;
       }
