@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -10,6 +12,7 @@
 #include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
+#include "core/validate.hpp"
 #include "dim3/tet_optimize.hpp"
 
 namespace febemesh::dim3 {
@@ -229,6 +232,15 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
 
   std::vector<P3> peel_points;
   std::size_t n_prev_problems = 0;
+  int topology_refinements = 0;
+  struct Saved {
+    Result3d r;
+    Orthtree<3> tree;
+    Flags in;
+    OctantComplexResult oc;
+    TetMesh fe;
+  };
+  std::optional<Saved> saved;  // the last valid mesh whose topology a refinement tries to fix
   for (int attempt = 0;; ++attempt) {
     const bool last = attempt >= opt.max_repairs;
     say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
@@ -332,6 +344,34 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       for (std::size_t f : folded_faces(fe.mesh, fe.where, s))
         problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds after smoothing"});
     }
+    if (problems.empty() && topology_refinements < opt.topology_refinements && !last) {
+      // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the
+      // solid's Euler characteristic is not half the surface's): refine the octants the
+      // surface crosses once more and rebuild, rather than keep a mesh that misses them.
+      const long euler = euler_characteristic<3>(fe.mesh);
+      const bool topology_wrong = s.euler_characteristic() % 2 == 0 && euler != s.euler_characteristic() / 2;
+      if (topology_wrong || r.n_islands_dropped > 0) {
+        Flags flags(tree.n_leaves(), 0);
+        std::size_t n_marked = 0;
+        for (std::size_t i = 0; i < tree.n_leaves(); ++i)
+          if (sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+        if (n_marked > 0) {
+          ++topology_refinements;
+          ++r.n_repairs;
+          say("repair " + std::to_string(attempt + 1) + ": refining the " + std::to_string(n_marked) +
+              " octants on the surface (" +
+              (topology_wrong ? "Euler characteristic " + std::to_string(euler) + ", expected " +
+                                    std::to_string(s.euler_characteristic() / 2)
+                              : std::to_string(r.n_islands_dropped) + " octants in islands") +
+              ")");
+          saved = Saved{r, tree, in, oc, std::move(fe)};
+          n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
+          tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
+          clock.lap("repair refinement");
+          continue;
+        }
+      }
+    }
     if (problems.empty()) {
       if (opt.hex_dominant) {
         say("finite elements: hexahedra where the cells conform");
@@ -361,7 +401,23 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     Flags flags;
     std::vector<P3> places;
     for (const Problem3& pr : problems) places.push_back(pr.where);
-    if (last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags))
+    const bool stuck = last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags);
+    if (stuck && saved) {
+      // The finer tree could not be built: the valid coarser mesh stands (with its volume
+      // warning), rather than no mesh.
+      say("repair " + std::to_string(attempt + 1) + ": the refined tree has " + std::to_string(problems.size()) +
+          " problem(s) (" + describe(problems) + "); keeping the mesh before the refinement");
+      std::vector<StageTime3> times = std::move(r.times);
+      r = std::move(saved->r);
+      r.times = std::move(times);
+      if (opt.hex_dominant) r.hex = make_hex_dominant(saved->tree, saved->oc.complex, saved->fe, opt.hex);
+      r.stats = saved->oc.stats;
+      r.fe = std::move(saved->fe);
+      r.interior = std::move(saved->in);
+      r.tree = std::move(saved->tree);
+      return r;
+    }
+    if (stuck)
       throw GeometryError("the boundary octants cannot be built (" + std::to_string(problems.size()) +
                           " problem(s) after " + std::to_string(r.n_repairs) + " repair(s)" +
                           (worse ? ", the last one made it worse" : ", maximum level " + std::to_string(max_level)) +

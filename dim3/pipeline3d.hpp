@@ -33,6 +33,9 @@ struct Options3d {
   int optimize_sweeps = 12;          ///< node-by-node dihedral-angle sweeps after smoothing
   double target_dihedral_deg = 30.0; ///< nodes whose tets all reach this angle are left alone
   int max_repairs = 12;              ///< local refinements when the construction needs them
+  /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
+  /// the wrong Euler characteristic).
+  int topology_refinements = 2;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
