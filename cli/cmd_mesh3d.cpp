@@ -26,10 +26,12 @@ namespace {
 
 const char* help_text =
     "usage: febemesh mesh3d SURFACE -o DIR [options]\n\n"
-    "Tetrahedral FE mesh of the solid bounded by a closed triangle surface (OFF, STL, OBJ, PLY)\n"
-    "and the triangle BE mesh of its boundary, sharing nodes: octree refined by a level field,\n"
-    "2:1 balance, interior octants, boundary octants by projection onto the surface, feature\n"
-    "snapping, tetrahedra from templates, guarded smoothing.\n\n"
+    "Tetrahedral (or hex-dominant) FE mesh of the solid bounded by a closed triangle surface\n"
+    "(OFF, STL, OBJ, PLY) and the triangle (or quad) BE mesh of its boundary, sharing nodes:\n"
+    "octree refined by a level field, 2:1 balance, interior octants, boundary octants by\n"
+    "projection onto the surface, feature snapping, tetrahedra from templates, guarded\n"
+    "smoothing; with --elements hex the tetrahedra of each octant are merged into a hexahedron\n"
+    "or pyramids where that conforms.\n\n"
     "options:\n"
     "  -o DIR              output folder (mesh.msh, mesh.vtu, report.json), written atomically\n"
     "  --level N           global octree level at the surface (1..9, default 4)\n"
