@@ -6,6 +6,8 @@
 #include <limits>
 #include <span>
 
+#include "core/error.hpp"
+
 namespace febemesh::dim2 {
 namespace {
 
@@ -15,16 +17,44 @@ double cross(const P2& a, const P2& b, const P2& c) {
   return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
 }
 
-/// Smallest corner angle of polygon pts (CCW), degrees; -1 if any corner turns the wrong way.
-double polygon_min_angle(const P2* pts, int n) {
+/// Corner angle (degrees) from its cross and dot products.
+double corner_angle(double cr, double dot) { return std::atan2(std::abs(cr), dot) * 180.0 / M_PI; }
+
+/// Slow twin of polygon_min_angle: every corner's atan2.
+double polygon_min_angle_ref(const P2* pts, int n) {
   double best = 180.0;
   for (int k = 0; k < n; ++k) {
     const P2 &prev = pts[(k + n - 1) % n], &cur = pts[k], &next = pts[(k + 1) % n];
     if (cross(prev, cur, next) <= 0) return -1.0;
     const P2 a = prev - cur, b = next - cur;
-    const double ang = std::atan2(std::abs(a[0] * b[1] - a[1] * b[0]), a.dot(b)) * 180.0 / M_PI;
-    best = std::min(best, ang);
+    best = std::min(best, corner_angle(a[0] * b[1] - a[1] * b[0], a.dot(b)));
   }
+  return best;
+}
+
+/// Smallest corner angle of polygon pts (CCW), degrees; -1 if any corner turns the wrong way.
+/// Cost: the angle is decreasing in its cotangent dot/|cross|, so atan2 runs only for the
+/// corners whose cotangent is within a margin of the largest (ties and near-ties: all of them).
+/// The margin (1e-7 relative) dwarfs the rounding of the quotients and of atan2, so the minimum
+/// is the one polygon_min_angle_ref takes, bit for bit.
+double polygon_min_angle(const P2* pts, int n) {
+  MESH_ASSERT(n >= 3 && n <= 4, "polygon of " << n << " corners");
+  double cr[4], dot[4], cot[4];
+  for (int k = 0; k < n; ++k) {
+    const P2 &prev = pts[(k + n - 1) % n], &cur = pts[k], &next = pts[(k + 1) % n];
+    if (cross(prev, cur, next) <= 0) return -1.0;
+    const P2 a = prev - cur, b = next - cur;
+    cr[k] = std::abs(a[0] * b[1] - a[1] * b[0]);
+    dot[k] = a.dot(b);
+    if (!(cr[k] > 0) || !std::isfinite(dot[k])) return polygon_min_angle_ref(pts, n);
+    cot[k] = dot[k] / cr[k];
+  }
+  double top = cot[0];
+  for (int k = 1; k < n; ++k) top = std::max(top, cot[k]);
+  const double margin = 1e-7 * (1.0 + std::abs(top));
+  double best = 180.0;
+  for (int k = 0; k < n; ++k)
+    if (cot[k] >= top - margin) best = std::min(best, corner_angle(cr[k], dot[k]));
   return best;
 }
 
@@ -41,6 +71,14 @@ double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) {
   std::array<P2, 4> p;
   for (int k = 0; k < n; ++k) p[k] = m.points[m.solid.nodes(id)[k].v];
   return polygon_min_angle(p.data(), n);
+}
+
+double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e) {
+  const ElemId id{static_cast<std::int32_t>(e)};
+  const int n = m.solid.n_nodes_of(id);
+  std::array<P2, 4> p;
+  for (int k = 0; k < n; ++k) p[k] = m.points[m.solid.nodes(id)[k].v];
+  return polygon_min_angle_ref(p.data(), n);
 }
 
 namespace {

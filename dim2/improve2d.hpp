@@ -26,6 +26,8 @@ struct ImproveStats {
 
 /// Smallest corner angle (degrees) of a triangle or quadrilateral; <= 0 when inverted.
 double min_corner_angle_deg(const Mesh<2>& m, std::size_t e);
+/// Slow twin of min_corner_angle_deg (atan2 at every corner): the same value, bit for bit.
+double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e);
 
 /// Maps a point near the curve onto it for interface node v, or returns the node's current
 /// position when it must not move there (e.g. onto another loop).
