@@ -197,7 +197,30 @@ std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe
 
 }  // namespace
 
+namespace {
+Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
+}  // namespace
+
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+  if (!opt.snap_features || s.features().n_feature_edges() == 0) return mesh3d_once(s, opt, progress);
+  try {
+    return mesh3d_once(s, opt, progress);
+  } catch (const GeometryError& e) {
+    // Feature snapping pulls nodes across octants; on coarsely faceted surfaces (every edge a
+    // feature: tori of 8 segments) it leaves tetrahedra no node move can unfold, where the plain
+    // projection meshes validly. Same input, same fallback: still deterministic.
+    if (progress) progress(std::string("without feature snapping, after: ") + e.what());
+    Options3d plain = opt;
+    plain.snap_features = false;
+    Result3d r = mesh3d_once(s, plain, progress);
+    r.features_dropped = true;
+    return r;
+  }
+}
+
+namespace {
+
+Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   auto say = [&](const std::string& msg) {
     if (progress) progress(msg);
   };
@@ -430,5 +453,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     clock.lap("repair refinement");
   }
 }
+
+}  // namespace
 
 }  // namespace febemesh::dim3

@@ -58,6 +58,7 @@ struct Result3d {
   std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes
   std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
   int n_repairs = 0;
+  bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
@@ -69,7 +70,8 @@ struct Result3d {
 using Progress3 = std::function<void(const std::string&)>;
 
 /// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
-/// LimitError when the tree would exceed max_cells. `s` gets the options' levels.
+/// LimitError when the tree would exceed max_cells. `s` gets the options' levels. When it fails
+/// with feature snapping it runs once more without (Result3d::features_dropped).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 }  // namespace febemesh::dim3
