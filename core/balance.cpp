@@ -291,12 +291,26 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
       const auto& next = internal[level + 1];
       const std::uint64_t parent_mask = ~(volume_units(Cell<Dim>{{}, std::uint8_t(level)}) - 1);
       const int child_shift = Dim * (max_level<Dim> - level - 1);
-      std::size_t j = 0;
-      for (const std::uint64_t key : next) {
-        const std::uint64_t pk = key & parent_mask;
-        while (here[j] != pk) ++j;  // every internal cell's parent is internal
-        m[j] = std::uint8_t(m[j] | (1u << ((key >> child_shift) & (nc - 1))));
-      }
+      // Pieces of `next` cut at sibling groups, so that no two threads write the same byte.
+      const int n_pieces = next.size() < 4096 ? 1 : n_threads;
+      on_threads(n_pieces, [&](int t) {
+        std::size_t i = next.size() * std::size_t(t) / std::size_t(n_pieces);
+        std::size_t end = next.size() * std::size_t(t + 1) / std::size_t(n_pieces);
+        const auto group_start = [&](std::size_t c) {
+          while (c > 0 && c < next.size() && (next[c] & parent_mask) == (next[c - 1] & parent_mask)) ++c;
+          return c;
+        };
+        i = group_start(i);
+        end = group_start(end);
+        if (i >= end) return;
+        std::size_t j = std::size_t(std::lower_bound(here.begin(), here.end(), next[i] & parent_mask) - here.begin());
+        for (; i < end; ++i) {
+          const std::uint64_t key = next[i];
+          const std::uint64_t pk = key & parent_mask;
+          while (here[j] != pk) ++j;  // every internal cell's parent is internal
+          m[j] = std::uint8_t(m[j] | (1u << ((key >> child_shift) & (nc - 1))));
+        }
+      });
     }
     std::vector<std::uint64_t>().swap(internal[level]);
   }
