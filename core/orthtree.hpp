@@ -26,7 +26,8 @@ void deallocate_leaf_bytes(void* p, std::size_t bytes) noexcept;
 }  // namespace detail
 
 /// Allocator of the tree's leaf array. It differs from std::allocator in one respect: resize(n)
-/// leaves the new cells unwritten (construct() without arguments does nothing), so that threads
+/// and emplace_back() leave the new cells unwritten (construct() without arguments does
+/// nothing; pass a value, e.g. resize(n, Cell<Dim>{}), to get zero cells), so that threads
 /// can fill disjoint parts of a freshly sized array in parallel. Value-initialising them first
 /// would be one more serial pass over memory, and memory bandwidth, not arithmetic, is what
 /// bounds refinement and balance on two threads here. Cell is an aggregate of integers with no
