@@ -92,11 +92,6 @@ class LevelSpool {
       begin = stop;
     }
   }
-  /// Calls f(level) for the leaves [begin, end) without releasing them (before any consume()).
-  template <class F> void peek(std::size_t begin, std::size_t end, F&& f) const {
-    for (std::size_t i = begin; i < end; ++i) f(blocks_[i / block_bytes][i % block_bytes]);
-  }
-
  private:
   // Small pages: a block holds 256 Ki leaves and costs one fault per 4096 of them; a huge page
   // would keep 2 MiB resident per thread for trees of any size.
@@ -239,9 +234,9 @@ template <class F> void on_threads(int n_threads, const F& f) {
 /// leaves in that order. The result does not depend on the thread count: the work is cut into
 /// contiguous chunks, each chunk's leaves form one range of its thread's spool, and the ranges
 /// are placed in chunk order. Two phases: the threads expand chunks (taken dynamically, in
-/// increasing order), then, with every chunk's size and so its place in the result known, each
-/// thread writes an equal share of the result, reading whichever spools hold it; a spool block
-/// is unmapped as soon as its last leaf is read. Both phases run in parallel: a serial copy into
+/// increasing order), then, with every chunk's size and so its place in the result known, they
+/// write the chunks' cells there (again taken dynamically), reading whichever spools hold them;
+/// a spool block is unmapped as soon as its last leaf is read. Both phases run in parallel: a serial copy into
 /// the result was a third of a refinement (measured) and kept two threads near 1x.
 template <int Dim, class Work>
 LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& budget, int n_threads) {
@@ -255,7 +250,7 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
   // Many more chunks than threads, taken dynamically: refinement is concentrated near the
   // boundary, so equal item counts are far from equal work.
   const std::size_t n_chunks = n_threads == 1 ? std::min<std::size_t>(n_work, 1)
-                                              : std::min(n_work, std::size_t(n_threads) * 16);
+                                              : std::min(n_work, std::size_t(n_threads) * 64);
   std::vector<Range> ranges(n_chunks);
   std::vector<std::exception_ptr> errors(n_chunks);
   std::atomic<std::size_t> next{0};
@@ -301,46 +296,22 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
   out.resize(total);  // sized, not written (LeafAllocator): the threads write each cell once
   Cell<Dim>* const cells = out.data();
   for (auto& spool : spools) spool.seal();
-  // Thread t writes cells [total t / n, total (t + 1) / n): equal shares, whichever thread
-  // expanded them (the expansion balances CPU time, not leaves). A share starting inside a
-  // chunk starts from the chunk's first key plus the volumes of the leaves before it.
-  struct Start {
-    std::size_t chunk = 0, skip = 0;
-    std::uint64_t key = 0;
-  };
-  std::vector<Start> starts(static_cast<std::size_t>(n_threads));
-  for (std::size_t t = 0; t < starts.size(); ++t) {
-    const std::size_t g = total * t / starts.size();
-    if (g >= total) continue;
-    Start& st = starts[t];
-    st.chunk = std::size_t(std::upper_bound(offset.begin(), offset.end(), g) - offset.begin()) - 1;
-    st.skip = g - offset[st.chunk];
-    const Range& r = ranges[st.chunk];
-    st.key = detail::interleave<Dim>(r.first);
-    spools[std::size_t(r.spool)].peek(r.begin, r.begin + st.skip,
-                                      [&](std::uint8_t level) { st.key += volume_of_level<Dim>(level); });
-  }
-  on_threads(n_threads, [&](int t) {
-    const std::size_t g0 = total * std::size_t(t) / std::size_t(n_threads);
-    const std::size_t g1 = total * std::size_t(t + 1) / std::size_t(n_threads);
-    if (g0 >= g1) return;
-    Start st = starts[std::size_t(t)];
-    Cell<Dim>* dst = cells + g0;
-    for (std::size_t left = g1 - g0, k = st.chunk; left > 0; ++k) {
+  // The threads take chunks in order, dynamically like the expansion, and write each where
+  // the counts put it, whichever spool holds it: a thread slowed by another process then does
+  // less, where fixed equal shares would make the other thread wait for it.
+  next = 0;
+  on_threads(n_threads, [&](int) {
+    for (std::size_t k; (k = next.fetch_add(1)) < n_chunks;) {
       const Range& r = ranges[k];
-      if (k != st.chunk) {
-        st.skip = 0;
-        st.key = detail::interleave<Dim>(r.first);
-      }
-      const std::size_t n = std::min(left, r.end - r.begin - st.skip);
-      spools[std::size_t(r.spool)].consume(r.begin + st.skip, r.begin + st.skip + n, [&](std::uint8_t level) {
+      Cell<Dim>* dst = cells + offset[k];
+      std::uint64_t key = detail::interleave<Dim>(r.first);
+      spools[std::size_t(r.spool)].consume(r.begin, r.end, [&](std::uint8_t level) {
         Cell<Dim> c;
-        c.anchor = detail::deinterleave<Dim>(st.key);
+        c.anchor = detail::deinterleave<Dim>(key);
         c.level = level;
         ::new (static_cast<void*>(dst++)) Cell<Dim>(c);
-        st.key += volume_of_level<Dim>(level);
+        key += volume_of_level<Dim>(level);
       });
-      left -= n;
     }
   });
   return out;
@@ -389,7 +360,7 @@ Orthtree<Dim> subdivide_by_control(const Box<Dim>& domain, const ControlFn<Dim>&
   std::vector<Item<Dim>> items{{Cell<Dim>{}, true}};
   if (opt.n_threads > 1) {
     // Apply the rule breadth-first at shallow levels until there are enough subtrees to share.
-    const std::size_t wanted = std::size_t(opt.n_threads) * 64;
+    const std::size_t wanted = std::size_t(opt.n_threads) * 256;
     for (;;) {
       const auto n_expand = std::count_if(items.begin(), items.end(), [](const Item<Dim>& it) { return it.expand; });
       if (n_expand == 0 || std::size_t(n_expand) >= wanted || items.size() > opt.max_leaves) break;
