@@ -243,7 +243,11 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
 
   {
     const DirectionTable<Dim> table(kind);
-    std::vector<std::vector<std::uint64_t>> candidates(static_cast<std::size_t>(n_threads));
+    // One cache line per thread's vector: push_back updates its end pointer on every key.
+    struct alignas(64) Keys {
+      std::vector<std::uint64_t> v;
+    };
+    std::vector<Keys> candidates(static_cast<std::size_t>(n_threads));
     std::vector<std::uint64_t> merged;
     for (int level = deepest - 1; level >= 1; --level) {
       const auto& here = internal[level];
@@ -259,7 +263,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
         cut[std::size_t(t)] = c;
       }
       on_threads(n_pieces, [&](int t) {
-        auto& mine = candidates[std::size_t(t)];
+        auto& mine = candidates[std::size_t(t)].v;
         mine.clear();
         append_candidates<Dim>(here, cut[std::size_t(t)], cut[std::size_t(t) + 1], level, table, mine);
         std::sort(mine.begin(), mine.end());
@@ -268,7 +272,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
       // Merge the sorted pieces into the level above (a union: keys may repeat across pieces).
       auto& below = internal[level - 1];
       for (int t = 0; t < n_pieces; ++t) {
-        const auto& mine = candidates[std::size_t(t)];
+        const auto& mine = candidates[std::size_t(t)].v;
         merged.clear();
         merged.reserve(mine.size() + below.size());
         std::set_union(mine.begin(), mine.end(), below.begin(), below.end(), std::back_inserter(merged));
