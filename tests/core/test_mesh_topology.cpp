@@ -9,6 +9,8 @@
 #include "test_mesh_fixtures.hpp"
 
 using namespace febemesh;
+using febemesh::test::grid_mesh;
+using febemesh::test::hanging_mesh;
 
 namespace {
 
@@ -48,14 +50,14 @@ void check_same_as_ref(const Elements& els) {
   CHECK(fast == boundary_ref(els));
 }
 
-/// Random elements of the given types over nodes [0, n_nodes): duplicates and non-manifold
+/// Random elements of the given types over nodes [0, n_vertices): duplicates and non-manifold
 /// configurations included (the functions must not assume a valid mesh).
-Elements soup(const std::vector<ElemType>& types, int n_elems, int n_nodes) {
+Elements soup(const std::vector<ElemType>& types, int n_elems, int n_vertices) {
   Elements els;
   for (int e = 0; e < n_elems; ++e) {
     const ElemType t = types[*rc::gen::inRange<std::size_t>(0, types.size())];
     const int n = n_nodes(t);
-    const auto nodes = *rc::gen::unique<std::vector<int>>(n, rc::gen::inRange(0, n_nodes));
+    const auto nodes = *rc::gen::unique<std::vector<int>>(n, rc::gen::inRange(0, n_vertices));
     std::vector<VertexId> v;
     for (int x : nodes) v.push_back(VertexId{x});
     els.add(t, v.data(), n);
