@@ -144,6 +144,8 @@ template <int Dim> std::size_t find_covering_leaf(const Orthtree<Dim>& t, const 
 /// size or coarser; the 2^(Dim-1) (or more, if unbalanced) finer leaves touching the facet,
 /// in Morton order.
 template <int Dim> std::vector<std::size_t> face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f);
+/// The same into `out` (cleared first): loops over every facet reuse one vector.
+template <int Dim> void face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f, std::vector<std::size_t>& out);
 /// Leaves whose closed boxes overlap the closed real box `b`, in Morton order.
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b);
 

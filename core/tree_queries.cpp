@@ -106,14 +106,19 @@ template <int Dim> std::size_t find_covering_leaf(const Orthtree<Dim>& t, const 
 }
 
 template <int Dim> std::vector<std::size_t> face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f) {
+  std::vector<std::size_t> out;
+  face_neighbours(t, i, f, out);
+  return out;
+}
+
+template <int Dim> void face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f, std::vector<std::size_t>& out) {
   MESH_ASSERT(i < t.n_leaves(), "leaf " << i << " of " << t.n_leaves());
   MESH_ASSERT(f >= 0 && f < Cube<Dim>::n_faces, "facet " << f);
-  std::vector<std::size_t> out;
+  out.clear();
   Cell<Dim> n;
-  if (!face_neighbour(t.leaf(i), f, n)) return out;
+  if (!face_neighbour(t.leaf(i), f, n)) return;
   // The neighbour's leaves that touch leaf i lie on n's facet facing back: the opposite side.
   facet_leaves(t, n, face_axis(f), 1 - face_side(f), out);
-  return out;
 }
 
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b) {
@@ -127,6 +132,7 @@ template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t
   template std::size_t locate<D>(const Orthtree<D>&, const LatticePoint<D>&);                 \
   template std::size_t find_covering_leaf<D>(const Orthtree<D>&, const Cell<D>&);             \
   template std::vector<std::size_t> face_neighbours<D>(const Orthtree<D>&, std::size_t, int); \
+  template void face_neighbours<D>(const Orthtree<D>&, std::size_t, int, std::vector<std::size_t>&); \
   template std::vector<std::size_t> leaves_in_box<D>(const Orthtree<D>&, const Box<D>&);
 
 FEBEMESH_INSTANTIATE_QUERIES(2)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
@@ -148,6 +149,15 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
   std::size_t removed = 0;
   FreeEdges facets;
   bool fresh = false;  // `facets` is free_facets(t, in)
+  // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
+  // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
+  // names its edge: edges of different lengths or axes never share one.
+  std::unordered_map<std::uint64_t, double> corner_distance, midpoint_distance;
+  auto cached = [&](std::unordered_map<std::uint64_t, double>& cache, std::uint64_t key, const Point<2>& p) {
+    const auto [it, added] = cache.try_emplace(key, 0.0);
+    if (added) it->second = curve.closest_point(p).distance;
+    return it->second;
+  };
   for (int pass = 0; pass < 4; ++pass) {
     facets = free_facets(t, in);
     fresh = true;
@@ -156,8 +166,10 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
       const auto c = f.corners();
       const double h = facet_length(t, f);
       const Point<2> a = position(t, c[0]), b = position(t, c[1]);
-      const double d = std::min({curve.closest_point(a).distance, curve.closest_point(b).distance,
-                                 curve.closest_point(0.5 * (a + b)).distance});
+      const LP doubled{c[0][0] + c[1][0], c[0][1] + c[1][1]};
+      const double d = std::min({cached(corner_distance, point_key<2>(c[0]), a),
+                                 cached(corner_distance, point_key<2>(c[1]), b),
+                                 cached(midpoint_distance, point_key<2>(doubled), 0.5 * (a + b))});
       if (d < fraction * h) drop.push_back(f.leaf);
     }
     std::sort(drop.begin(), drop.end());
