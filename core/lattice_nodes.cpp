@@ -55,6 +55,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   }
 
   // The leaves touching node p are those containing the 2^Dim finest lattice cells around p.
+  const LeafKeys<Dim> leaf_keys(t);
   nodes.hanging.assign(keys.size(), 0);
   for (std::size_t n = 0; n < nodes.points.size(); ++n) {
     const LatticePoint<Dim>& p = nodes.points[n];
@@ -70,7 +71,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
         }
       }
       if (!inside) continue;
-      const std::size_t j = locate(t, q);
+      const std::size_t j = leaf_keys.locate(q);
       if (j != no_leaf && kept(j) && !is_corner(t.leaf(j), p)) nodes.hanging[n] = 1;
     }
   }

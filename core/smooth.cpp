@@ -51,8 +51,6 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   const std::size_t n = mesh.points.size();
   MESH_ASSERT(options.fixed.empty() || options.fixed.size() == n, "fixed has " << options.fixed.size() << " entries");
   SmoothStats stats;
-  const std::vector<double> q0 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
-  stats.min_quality_before = q0.empty() ? 0.0 : *std::min_element(q0.begin(), q0.end());
 
   const Csr neighbours = build_csr(n, both_ways(unique_edges(mesh.solid)));
   Elements boundary;
@@ -71,14 +69,21 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
 
   auto element_state = [&](std::int32_t e) {
     const auto ep = element_points<Dim>(mesh.solid, ElemId{e}, mesh.points);
-    const ElemType t = mesh.solid.type[e];
-    return std::pair{min_corner_jacobian<Dim>(t, ep.span()) > 0.0, scaled_jacobian<Dim>(t, ep.span())};
+    const auto [jac, scaled] = jacobians<Dim>(mesh.solid.type[e], ep.span());
+    return std::pair{jac > 0.0, scaled};
+  };
+  // The scaled Jacobians of `state` are those of the current points (before and after).
+  auto min_quality = [&](const std::vector<std::pair<bool, double>>& st) {
+    double q = std::numeric_limits<double>::infinity();
+    for (const auto& s : st) q = std::min(q, s.second);
+    return st.empty() ? 0.0 : q;
   };
 
   // The state of every element, refreshed where a move is accepted: the guard compares against
   // it instead of re-evaluating the incident elements before each move (same values).
   std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
+  stats.min_quality_before = min_quality(state);
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
     for (std::size_t v = 0; v < n; ++v) {
@@ -116,8 +121,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       }
     }
   }
-  const std::vector<double> q1 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
-  stats.min_quality_after = q1.empty() ? 0.0 : *std::min_element(q1.begin(), q1.end());
+  stats.min_quality_after = min_quality(state);
   return stats;
 }
 

@@ -189,6 +189,14 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   QuadrantComplex& qc = res.complex;
   const LatticeNodes<2> nodes = lattice_nodes(t, &in);
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
+  // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
+  std::vector<std::uint64_t> node_keys(nodes.points.size());
+  for (std::size_t k = 0; k < nodes.points.size(); ++k) node_keys[k] = point_key<2>(nodes.points[k]);
+  auto find_node = [&](const LP& p) {
+    const std::uint64_t key = point_key<2>(p);
+    const auto it = std::lower_bound(node_keys.begin(), node_keys.end(), key);
+    return it != node_keys.end() && *it == key ? std::int32_t(it - node_keys.begin()) : std::int32_t(-1);
+  };
 
   // Interior quadrants: CCW rings with hanging mid-edge nodes.
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
@@ -200,9 +208,9 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     for (int k = 0; k < 4; ++k) {
       const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
       q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
-      q.ring.push_back(nodes.find(a));
+      q.ring.push_back(find_node(a));
       if (length(c) >= 2) {
-        const std::int32_t m = nodes.find(midpoint(a, b));
+        const std::int32_t m = find_node(midpoint(a, b));
         if (m >= 0) q.ring.push_back(m);
       }
     }
@@ -217,7 +225,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   std::vector<std::array<std::int32_t, 2>> ends(facets.size());
   for (std::size_t k = 0; k < facets.size(); ++k) {
     const auto c = facets[k].corners();
-    ends[k] = {nodes.find(c[0]), nodes.find(c[1])};
+    ends[k] = {find_node(c[0]), find_node(c[1])};
     MESH_ASSERT(ends[k][0] >= 0 && ends[k][1] >= 0, "free edge corner is not a node");
     if (next_facet[ends[k][0]] >= 0) {
       res.problems.push_back({qc.points[ends[k][0]], "interior quadrants meet only at a vertex"});

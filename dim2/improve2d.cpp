@@ -253,13 +253,18 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         m.points[v] = saved + step * (target - saved);
         if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
         if (m.points[v] == saved) break;
-        double q = 180.0;
+        // Accepted iff every incident element's angle exceeds old_q + 1e-12: the first one
+        // that does not rejects the step, the others need not be evaluated.
+        bool better = true;
         trial.clear();
         for (const std::int32_t e : elems) {
           trial.push_back(min_corner_angle_deg(m, e));
-          q = std::min(q, trial.back());
+          if (!(trial.back() > old_q + 1e-12)) {
+            better = false;
+            break;
+          }
         }
-        if (q > old_q + 1e-12) {
+        if (better) {
           moved = true;
           break;
         }
