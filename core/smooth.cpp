@@ -100,18 +100,22 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       if (target == mesh.points[v]) continue;
 
       double old_min = std::numeric_limits<double>::infinity();
-      for (const auto e : elems) old_min = std::min(old_min, state[e].second);
+      std::size_t worst = 0;
+      for (std::size_t k = 0; k < elems.size(); ++k) {
+        if (state[elems[k]].second < old_min) worst = k;
+        old_min = std::min(old_min, state[elems[k]].second);
+      }
       const Point<Dim> saved = mesh.points[v];
       mesh.points[v] = target;
+      // Accepted iff no valid element inverts and every element stays >= old_min: the first
+      // element that fails decides, the element that held old_min (likeliest to drop) first.
       bool accept = true;
-      double new_min = std::numeric_limits<double>::infinity();
-      after.clear();
-      for (std::size_t k = 0; k < elems.size() && accept; ++k) {
-        after.push_back(element_state(elems[k]));
-        accept = after.back().first || !state[elems[k]].first;
-        new_min = std::min(new_min, after.back().second);
+      after.resize(elems.size());
+      for (std::size_t j = 0; j < elems.size() && accept; ++j) {
+        const std::size_t k = j == 0 ? worst : (j <= worst ? j - 1 : j);
+        after[k] = element_state(elems[k]);
+        accept = (after[k].first || !state[elems[k]].first) && after[k].second >= old_min;
       }
-      accept = accept && new_min >= old_min;
       if (accept) {
         ++stats.moves_accepted;
         for (std::size_t k = 0; k < elems.size(); ++k) state[elems[k]] = after[k];

@@ -69,6 +69,15 @@ struct Projector {
   /// Closest point of the curve to q whose segment is admissible (paper: the shortest normal,
   /// then the next normals, then walking along the curve from the closest point).
   bool project(const Point<2>& q, double h, ClosestPoint<2>& out) {
+    // closest_points starts with closest_point, which is almost always admissible: only then
+    // are the other local minima (a search over every piece) needed.
+    if (opt.max_normals > 0) {
+      const ClosestPoint<2> nearest = curve.closest_point(q);
+      if (admissible(q, nearest.point)) {
+        out = nearest;
+        return true;
+      }
+    }
     const std::vector<ClosestPoint<2>> cands = curve.closest_points(q, opt.max_normals);
     for (std::size_t k = 0; k < cands.size(); ++k) {
       if (admissible(q, cands[k].point)) {
