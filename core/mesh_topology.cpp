@@ -224,37 +224,54 @@ std::vector<FacetUse> facet_uses_ref(const Elements& els) {
 }
 
 // The facets used once are flagged by (element, local facet) and read back in that order.
-// Memory: the uses are ordered through a permutation of their indices (4 bytes a use) instead
-// of a sorted copy (facet_uses: 24), the same counting sort by smallest node then each node's
-// few uses by the rest of the key; the uses' generation order is (element, local facet).
+// Memory, this ran at the pipeline's peak: a use is 8 bytes, its (element, local facet) packed
+// and its second smallest node, bucketed by its smallest node (counting sort); full keys are
+// recomputed only to break ties inside a bucket. Which keys occur once does not depend on the
+// order within a bucket.
 std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
-  const std::vector<FacetUse> uses = unsorted_uses(solid);
-  if (uses.size() > std::numeric_limits<std::uint32_t>::max())
-    throw LimitError("boundary_facets: " + std::to_string(uses.size()) + " facet uses exceed 32-bit indices");
+  constexpr int facet_bits = 3;  // at most 6 facets per element
+  if (solid.size() >= (std::size_t(1) << (32 - facet_bits)))
+    throw LimitError("boundary_facets: " + std::to_string(solid.size()) + " elements exceed packed 32-bit facet ids");
+  struct Use {
+    std::uint32_t id;  ///< element << facet_bits | local facet
+    std::int32_t second;  ///< key.v[1]
+  };
+  auto key = [&](std::uint32_t id) {
+    return key_of(facet_of(solid, ElemId{static_cast<std::int32_t>(id >> facet_bits)}, static_cast<int>(id & 7u)));
+  };
   std::int64_t top = -1;
-  for (const FacetUse& u : uses) top = std::max<std::int64_t>(top, u.key.v[0]);
+  for (const VertexId v : solid.node) top = std::max<std::int64_t>(top, v.v);
+  // Bucket = smallest id + 1 (ids are >= -1).
   std::vector<std::uint32_t> start(static_cast<std::size_t>(top + 3), 0);
-  for (const FacetUse& u : uses) ++start[static_cast<std::size_t>(u.key.v[0] + 2)];
+  std::size_t n_uses = 0;
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (int f = 0; f < n_facets(solid.type[e]); ++f, ++n_uses)
+      ++start[static_cast<std::size_t>(key((std::uint32_t(e) << facet_bits) | std::uint32_t(f)).v[0] + 2)];
+  if (n_uses > std::numeric_limits<std::uint32_t>::max())
+    throw LimitError("boundary_facets: " + std::to_string(n_uses) + " facet uses exceed 32-bit indices");
   for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
-  std::vector<std::uint32_t> order(uses.size());
-  for (std::size_t i = 0; i < uses.size(); ++i) order[start[static_cast<std::size_t>(uses[i].key.v[0] + 1)]++] = static_cast<std::uint32_t>(i);
-  // Bucket = smallest id + 1; start[b] is now the end of bucket b.
-  std::vector<std::uint8_t> once(uses.size(), 0);
-  std::size_t n_once = 0;
-  std::size_t lo = 0;
+  std::vector<Use> uses(n_uses);
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (int f = 0; f < n_facets(solid.type[e]); ++f) {
+      const std::uint32_t id = (std::uint32_t(e) << facet_bits) | std::uint32_t(f);
+      const FacetKey k = key(id);
+      uses[start[static_cast<std::size_t>(k.v[0] + 1)]++] = {id, k.v[1]};
+    }
+  // start[b] is now the end of bucket b.
+  std::vector<std::uint8_t> once(solid.size() << facet_bits, 0);
+  std::size_t n_once = 0, lo = 0;
   for (std::size_t b = 0; b + 1 < start.size(); ++b) {
     const std::size_t hi = start[b];
-    sort_bucket(order.begin() + static_cast<std::ptrdiff_t>(lo), order.begin() + static_cast<std::ptrdiff_t>(hi),
-                [&](std::uint32_t x, std::uint32_t y) {
-                  for (int k = 1; k < 4; ++k)
-                    if (uses[x].key.v[k] != uses[y].key.v[k]) return uses[x].key.v[k] < uses[y].key.v[k];
-                  return false;
-                });
+    auto less = [&](const Use& x, const Use& y) {
+      if (x.second != y.second) return x.second < y.second;
+      return key(x.id) < key(y.id);
+    };
+    std::sort(uses.begin() + static_cast<std::ptrdiff_t>(lo), uses.begin() + static_cast<std::ptrdiff_t>(hi), less);
     for (std::size_t i = lo; i < hi;) {
       std::size_t j = i + 1;
-      while (j < hi && uses[order[j]].key == uses[order[i]].key) ++j;
+      while (j < hi && uses[j].second == uses[i].second && key(uses[j].id) == key(uses[i].id)) ++j;
       if (j - i == 1) {
-        once[order[i]] = 1;
+        once[uses[i].id] = 1;
         ++n_once;
       }
       i = j;
@@ -263,10 +280,12 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
   }
   std::vector<BoundaryFacet> out;
   out.reserve(n_once);
-  for (std::size_t i = 0; i < uses.size(); ++i) {
-    if (!once[i]) continue;
-    out.push_back({facet_of(solid, uses[i].elem, uses[i].local), uses[i].elem, uses[i].local});
-  }
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (int f = 0; f < n_facets(solid.type[e]); ++f) {
+      if (!once[(e << facet_bits) | std::size_t(f)]) continue;
+      const ElemId id{static_cast<std::int32_t>(e)};
+      out.push_back({facet_of(solid, id, f), id, f});
+    }
   return out;
 }
 
