@@ -157,6 +157,8 @@ template <int Dim> class LeafKeys {
   explicit LeafKeys(const Orthtree<Dim>& t);
   std::size_t find_covering_leaf(const Cell<Dim>& c) const;
   std::size_t locate(const LatticePoint<Dim>& p) const;
+  /// locate, searching outward from leaf `hint` (O(log distance); e.g. the previous answer).
+  std::size_t locate_near(const LatticePoint<Dim>& p, std::size_t hint) const;
   void face_neighbours(std::size_t i, int f, std::vector<std::size_t>& out) const;
 
  private:

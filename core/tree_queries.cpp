@@ -49,6 +49,44 @@ template <class Keys> std::size_t lower_bound_key(const Keys& keys, std::size_t 
   return lo;
 }
 
+/// upper_bound_key over all keys, searched outward from `hint` (galloping, then binary search):
+/// O(log distance), the same answer. Successive queries at nearby keys pass the previous one.
+template <class Keys> std::size_t upper_bound_near(const Keys& keys, std::size_t hint, std::uint64_t key) {
+  const std::size_t n = keys.size();
+  if (hint > n) hint = n;
+  std::size_t lo = 0, hi = n, step = 1;
+  if (hint < n && !(key < keys[hint])) {  // the answer is after hint
+    lo = hint + 1;
+    for (;;) {
+      const std::size_t probe = lo - 1 + step;
+      if (probe >= n) {
+        hi = n;
+        break;
+      }
+      if (key < keys[probe]) {
+        hi = probe;
+        break;
+      }
+      lo = probe + 1;
+      step *= 2;
+    }
+  } else {  // the answer is at or before hint
+    hi = hint;
+    for (;;) {
+      if (hi == 0) return 0;
+      const std::size_t probe = hi >= step ? hi - step : 0;
+      if (key < keys[probe]) {
+        hi = probe;
+        step *= 2;
+      } else {
+        lo = probe + 1;
+        break;
+      }
+    }
+  }
+  return upper_bound_key(keys, lo, hi, key);
+}
+
 /// Index of the last leaf whose Morton key is <= key, or no_leaf. In a linear tree at most one
 /// leaf has a given key, so this is the only candidate to contain a cell anchored at `key`.
 template <class Keys> std::size_t last_at_or_before(const Keys& keys, std::uint64_t key) {
@@ -72,6 +110,14 @@ template <int Dim, class Keys> std::size_t covering_leaf(const Orthtree<Dim>& t,
   return j;
 }
 
+/// The same searched from a hint (upper_bound_near).
+template <int Dim, class Keys>
+std::size_t covering_leaf_near(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c, std::size_t hint) {
+  const std::size_t it = upper_bound_near(keys, hint, morton_key(c));
+  if (it == 0 || !contains_or_equals(t.leaf(it - 1), c)) return no_leaf;
+  return it - 1;
+}
+
 template <int Dim, class Keys> std::size_t leaf_at(const Orthtree<Dim>& t, const Keys& keys, const LatticePoint<Dim>& p) {
   for (int d = 0; d < Dim; ++d) {
     if (p[d] >= root_length<Dim>) return no_leaf;
@@ -85,8 +131,8 @@ template <int Dim, class Keys> std::size_t leaf_at(const Orthtree<Dim>& t, const
 /// Leaves inside cell c that touch its facet on side `side` of `axis`, depth first in Morton order.
 template <int Dim, class Keys>
 void facet_leaves(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c, int axis, int side,
-                  std::vector<std::size_t>& out) {
-  const std::size_t j = covering_leaf(t, keys, c);
+                  std::vector<std::size_t>& out, std::size_t hint) {
+  const std::size_t j = hint == no_leaf ? covering_leaf(t, keys, c) : covering_leaf_near(t, keys, c, hint);
   if (j != no_leaf) {
     out.push_back(j);
     return;
@@ -95,19 +141,20 @@ void facet_leaves(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c, 
   const std::size_t first = first_at_or_after(keys, morton_key(c));
   if (first == t.n_leaves() || keys[first] >= morton_key(c) + volume_units(c)) return;
   for (int i = 0; i < Cube<Dim>::n_children; ++i) {
-    if (int((i >> axis) & 1) == side) facet_leaves(t, keys, child(c, i), axis, side, out);
+    if (int((i >> axis) & 1) == side) facet_leaves(t, keys, child(c, i), axis, side, out, hint);
   }
 }
 
 template <int Dim, class Keys>
-void neighbours_across(const Orthtree<Dim>& t, const Keys& keys, std::size_t i, int f, std::vector<std::size_t>& out) {
+void neighbours_across(const Orthtree<Dim>& t, const Keys& keys, std::size_t i, int f, std::vector<std::size_t>& out,
+                       std::size_t hint = no_leaf) {
   MESH_ASSERT(i < t.n_leaves(), "leaf " << i << " of " << t.n_leaves());
   MESH_ASSERT(f >= 0 && f < Cube<Dim>::n_faces, "facet " << f);
   out.clear();
   Cell<Dim> n;
   if (!face_neighbour(t.leaf(i), f, n)) return;
   // The neighbour's leaves that touch leaf i lie on n's facet facing back: the opposite side.
-  facet_leaves(t, keys, n, face_axis(f), 1 - face_side(f), out);
+  facet_leaves(t, keys, n, face_axis(f), 1 - face_side(f), out, hint);
 }
 
 template <int Dim>
@@ -180,8 +227,19 @@ template <int Dim> std::size_t LeafKeys<Dim>::locate(const LatticePoint<Dim>& p)
   return leaf_at(*tree_, FlatKeys{keys_}, p);
 }
 
+template <int Dim> std::size_t LeafKeys<Dim>::locate_near(const LatticePoint<Dim>& p, std::size_t hint) const {
+  for (int d = 0; d < Dim; ++d) {
+    if (p[d] >= root_length<Dim>) return no_leaf;
+  }
+  Cell<Dim> unit;
+  unit.anchor = p;
+  unit.level = std::uint8_t(max_level<Dim>);
+  return covering_leaf_near(*tree_, FlatKeys{keys_}, unit, hint);
+}
+
 template <int Dim> void LeafKeys<Dim>::face_neighbours(std::size_t i, int f, std::vector<std::size_t>& out) const {
-  neighbours_across(*tree_, FlatKeys{keys_}, i, f, out);
+  // Most neighbours are near leaf i in Morton order: the searches start there.
+  neighbours_across(*tree_, FlatKeys{keys_}, i, f, out, i);
 }
 
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b) {
