@@ -224,17 +224,18 @@ std::vector<FacetUse> facet_uses_ref(const Elements& els) {
 }
 
 // The facets used once are flagged by (element, local facet) and read back in that order.
-// Memory, this ran at the pipeline's peak: a use is 8 bytes, its (element, local facet) packed
-// and its second smallest node, bucketed by its smallest node (counting sort); full keys are
-// recomputed only to break ties inside a bucket. Which keys occur once does not depend on the
-// order within a bucket.
+// Memory, this ran at the pipeline's peak: a use is 12 bytes, its (element, local facet) packed
+// and its second and third smallest nodes, bucketed by its smallest node (counting sort); the
+// full key is recomputed only when two uses agree on three nodes that are not -1 (faces of 4
+// nodes). Which keys occur once does not depend on the order within a bucket.
 std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
   constexpr int facet_bits = 3;  // at most 6 facets per element
   if (solid.size() >= (std::size_t(1) << (32 - facet_bits)))
     throw LimitError("boundary_facets: " + std::to_string(solid.size()) + " elements exceed packed 32-bit facet ids");
   struct Use {
-    std::uint32_t id;  ///< element << facet_bits | local facet
+    std::uint32_t id;     ///< element << facet_bits | local facet
     std::int32_t second;  ///< key.v[1]
+    std::int32_t third;   ///< key.v[2]; -1 for an edge, and then key.v[3] is -1 too
   };
   auto key = [&](std::uint32_t id) {
     return key_of(facet_of(solid, ElemId{static_cast<std::int32_t>(id >> facet_bits)}, static_cast<int>(id & 7u)));
@@ -255,7 +256,7 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
     for (int f = 0; f < n_facets(solid.type[e]); ++f) {
       const std::uint32_t id = (std::uint32_t(e) << facet_bits) | std::uint32_t(f);
       const FacetKey k = key(id);
-      uses[start[static_cast<std::size_t>(k.v[0] + 1)]++] = {id, k.v[1]};
+      uses[start[static_cast<std::size_t>(k.v[0] + 1)]++] = {id, k.v[1], k.v[2]};
     }
   // start[b] is now the end of bucket b.
   std::vector<std::uint8_t> once(solid.size() << facet_bits, 0);
@@ -264,12 +265,16 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
     const std::size_t hi = start[b];
     auto less = [&](const Use& x, const Use& y) {
       if (x.second != y.second) return x.second < y.second;
-      return key(x.id) < key(y.id);
+      if (x.third != y.third) return x.third < y.third;
+      return x.third >= 0 && key(x.id).v[3] < key(y.id).v[3];
+    };
+    auto same = [&](const Use& x, const Use& y) {
+      return x.second == y.second && x.third == y.third && (x.third < 0 || key(x.id).v[3] == key(y.id).v[3]);
     };
     std::sort(uses.begin() + static_cast<std::ptrdiff_t>(lo), uses.begin() + static_cast<std::ptrdiff_t>(hi), less);
     for (std::size_t i = lo; i < hi;) {
       std::size_t j = i + 1;
-      while (j < hi && uses[j].second == uses[i].second && key(uses[j].id) == key(uses[i].id)) ++j;
+      while (j < hi && same(uses[j], uses[i])) ++j;
       if (j - i == 1) {
         once[uses[i].id] = 1;
         ++n_once;
