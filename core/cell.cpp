@@ -7,15 +7,6 @@
 
 namespace febemesh {
 
-template <int Dim> std::uint32_t length(const Cell<Dim>& c) {
-  MESH_ASSERT(c.level <= max_level<Dim>, "level=" << int(c.level));
-  return std::uint32_t(1) << (max_level<Dim> - c.level);
-}
-
-template <int Dim> std::uint64_t morton_key(const Cell<Dim>& c) {
-  return detail::interleave<Dim>(c.anchor);
-}
-
 template <int Dim> bool morton_less(const Cell<Dim>& a, const Cell<Dim>& b) {
   const std::uint64_t ka = morton_key(a), kb = morton_key(b);
   return ka < kb || (ka == kb && a.level < b.level);
@@ -37,16 +28,6 @@ template <int Dim> Cell<Dim> parent(const Cell<Dim>& c) {
   const std::uint32_t mask = ~(length(p) - 1);
   for (int d = 0; d < Dim; ++d) p.anchor[d] = c.anchor[d] & mask;
   return p;
-}
-
-template <int Dim> Cell<Dim> child(const Cell<Dim>& c, int i) {
-  MESH_ASSERT(c.level < max_level<Dim>, "level=" << int(c.level));
-  MESH_ASSERT(i >= 0 && i < Cube<Dim>::n_children, "i=" << i);
-  Cell<Dim> ch;
-  ch.level = std::uint8_t(c.level + 1);
-  const std::uint32_t half = length(ch);
-  for (int d = 0; d < Dim; ++d) ch.anchor[d] = c.anchor[d] + (corner_is_upper(i, d) ? half : 0);
-  return ch;
 }
 
 template <int Dim> std::array<Cell<Dim>, Cube<Dim>::n_children> children(const Cell<Dim>& c) {
@@ -72,15 +53,6 @@ template <int Dim> Cell<Dim> ancestor(const Cell<Dim>& c, int level) {
   return a;
 }
 
-template <int Dim> bool is_ancestor(const Cell<Dim>& a, const Cell<Dim>& d) {
-  if (a.level >= d.level) return false;
-  const std::uint32_t mask = ~(length(a) - 1);
-  for (int k = 0; k < Dim; ++k) {
-    if ((d.anchor[k] & mask) != a.anchor[k]) return false;
-  }
-  return true;
-}
-
 template <int Dim> bool is_ancestor_ref(const Cell<Dim>& a, const Cell<Dim>& d) {
   // Box containment in 64-bit lattice coordinates: no bit tricks.
   if (a.level >= d.level) return false;
@@ -92,36 +64,7 @@ template <int Dim> bool is_ancestor_ref(const Cell<Dim>& a, const Cell<Dim>& d) 
   return true;
 }
 
-template <int Dim>
-bool neighbour(const Cell<Dim>& c, const Direction<Dim>& dir, Cell<Dim>& out) {
-  const std::int64_t len = length(c);
-  out.level = c.level;
-  for (int d = 0; d < Dim; ++d) {
-    const std::int64_t x = std::int64_t(c.anchor[d]) + dir[d] * len;
-    if (x < 0 || x + len > std::int64_t(root_length<Dim>)) return false;
-    out.anchor[d] = std::uint32_t(x);
-  }
-  return true;
-}
-
-template <int Dim> bool face_neighbour(const Cell<Dim>& c, int f, Cell<Dim>& out) {
-  Direction<Dim> dir{};
-  dir[face_axis(f)] = face_side(f) ? 1 : -1;
-  return neighbour<Dim>(c, dir, out);
-}
-
-template <int Dim> LatticePoint<Dim> corner(const Cell<Dim>& c, int k) {
-  LatticePoint<Dim> p;
-  const std::uint32_t len = length(c);
-  for (int d = 0; d < Dim; ++d) p[d] = c.anchor[d] + (corner_is_upper(k, d) ? len : 0);
-  return p;
-}
-
 template <int Dim> double lattice_volume(const Cell<Dim>& c) { return double(volume_units(c)); }
-
-template <int Dim> std::uint64_t volume_units(const Cell<Dim>& c) {
-  return std::uint64_t(1) << (Dim * (max_level<Dim> - c.level));
-}
 
 template <int Dim> std::uint64_t morton_key_ref(const Cell<Dim>& c) {
   std::uint64_t key = 0;
@@ -140,22 +83,6 @@ template <int Dim> Cell<Dim> cell_from_key(std::uint64_t key, int level) {
   return c;
 }
 
-template <int Dim> std::uint64_t point_key(const LatticePoint<Dim>& p) {
-  return detail::interleave<Dim>(p);
-}
-
-template <int Dim> LatticePoint<Dim> point_from_key(std::uint64_t key) {
-  return detail::deinterleave<Dim>(key);
-}
-
-template <int Dim> bool is_corner(const Cell<Dim>& c, const LatticePoint<Dim>& p) {
-  const std::uint32_t len = length(c);
-  for (int d = 0; d < Dim; ++d) {
-    if (p[d] != c.anchor[d] && p[d] != c.anchor[d] + len) return false;
-  }
-  return true;
-}
-
 template <int Dim> bool touches(const Cell<Dim>& c, const LatticePoint<Dim>& p) {
   const std::uint32_t len = length(c);
   for (int d = 0; d < Dim; ++d) {
@@ -165,27 +92,16 @@ template <int Dim> bool touches(const Cell<Dim>& c, const LatticePoint<Dim>& p) 
 }
 
 #define FEBEMESH_INSTANTIATE_CELL(D)                                                        \
-  template std::uint32_t length<D>(const Cell<D>&);                                         \
-  template std::uint64_t morton_key<D>(const Cell<D>&);                                     \
   template bool morton_less<D>(const Cell<D>&, const Cell<D>&);                             \
   template bool is_valid<D>(const Cell<D>&);                                                \
   template Cell<D> parent<D>(const Cell<D>&);                                               \
-  template Cell<D> child<D>(const Cell<D>&, int);                                           \
   template std::array<Cell<D>, Cube<D>::n_children> children<D>(const Cell<D>&);            \
   template int child_id<D>(const Cell<D>&);                                                 \
   template Cell<D> ancestor<D>(const Cell<D>&, int);                                        \
-  template bool is_ancestor<D>(const Cell<D>&, const Cell<D>&);                             \
   template bool is_ancestor_ref<D>(const Cell<D>&, const Cell<D>&);                         \
-  template bool face_neighbour<D>(const Cell<D>&, int, Cell<D>&);                           \
-  template bool neighbour<D>(const Cell<D>&, const Direction<D>&, Cell<D>&);                  \
-  template LatticePoint<D> corner<D>(const Cell<D>&, int);                                  \
   template double lattice_volume<D>(const Cell<D>&);                                        \
-  template std::uint64_t volume_units<D>(const Cell<D>&);                                   \
   template std::uint64_t morton_key_ref<D>(const Cell<D>&);                                 \
   template Cell<D> cell_from_key<D>(std::uint64_t, int);                                    \
-  template std::uint64_t point_key<D>(const LatticePoint<D>&);                              \
-  template LatticePoint<D> point_from_key<D>(std::uint64_t);                                \
-  template bool is_corner<D>(const Cell<D>&, const LatticePoint<D>&);                       \
   template bool touches<D>(const Cell<D>&, const LatticePoint<D>&);
 
 FEBEMESH_INSTANTIATE_CELL(2)

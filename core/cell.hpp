@@ -8,6 +8,7 @@
 
 #include "core/box.hpp"
 #include "core/cube.hpp"
+#include "core/error.hpp"
 
 namespace febemesh {
 
@@ -140,5 +141,80 @@ template <int Dim> inline std::array<std::uint32_t, Dim> deinterleave(std::uint6
   }
 }
 }  // namespace detail
+
+
+// ---- inline definitions: the tree's hot loops call these millions of times -----------------
+
+template <int Dim> inline std::uint32_t length(const Cell<Dim>& c) {
+  MESH_ASSERT(c.level <= max_level<Dim>, "level=" << int(c.level));
+  return std::uint32_t(1) << (max_level<Dim> - c.level);
+}
+
+template <int Dim> inline std::uint64_t morton_key(const Cell<Dim>& c) {
+  return detail::interleave<Dim>(c.anchor);
+}
+
+template <int Dim> inline Cell<Dim> child(const Cell<Dim>& c, int i) {
+  MESH_ASSERT(c.level < max_level<Dim>, "level=" << int(c.level));
+  MESH_ASSERT(i >= 0 && i < Cube<Dim>::n_children, "i=" << i);
+  Cell<Dim> ch;
+  ch.level = std::uint8_t(c.level + 1);
+  const std::uint32_t half = length(ch);
+  for (int d = 0; d < Dim; ++d) ch.anchor[d] = c.anchor[d] + (corner_is_upper(i, d) ? half : 0);
+  return ch;
+}
+
+template <int Dim> inline bool is_ancestor(const Cell<Dim>& a, const Cell<Dim>& d) {
+  if (a.level >= d.level) return false;
+  const std::uint32_t mask = ~(length(a) - 1);
+  for (int k = 0; k < Dim; ++k) {
+    if ((d.anchor[k] & mask) != a.anchor[k]) return false;
+  }
+  return true;
+}
+
+template <int Dim> inline bool neighbour(const Cell<Dim>& c, const Direction<Dim>& dir, Cell<Dim>& out) {
+  const std::int64_t len = length(c);
+  out.level = c.level;
+  for (int d = 0; d < Dim; ++d) {
+    const std::int64_t x = std::int64_t(c.anchor[d]) + dir[d] * len;
+    if (x < 0 || x + len > std::int64_t(root_length<Dim>)) return false;
+    out.anchor[d] = std::uint32_t(x);
+  }
+  return true;
+}
+
+template <int Dim> inline bool face_neighbour(const Cell<Dim>& c, int f, Cell<Dim>& out) {
+  Direction<Dim> dir{};
+  dir[face_axis(f)] = face_side(f) ? 1 : -1;
+  return neighbour<Dim>(c, dir, out);
+}
+
+template <int Dim> inline LatticePoint<Dim> corner(const Cell<Dim>& c, int k) {
+  LatticePoint<Dim> p;
+  const std::uint32_t len = length(c);
+  for (int d = 0; d < Dim; ++d) p[d] = c.anchor[d] + (corner_is_upper(k, d) ? len : 0);
+  return p;
+}
+
+template <int Dim> inline std::uint64_t point_key(const LatticePoint<Dim>& p) {
+  return detail::interleave<Dim>(p);
+}
+
+template <int Dim> inline LatticePoint<Dim> point_from_key(std::uint64_t key) {
+  return detail::deinterleave<Dim>(key);
+}
+
+template <int Dim> inline bool is_corner(const Cell<Dim>& c, const LatticePoint<Dim>& p) {
+  const std::uint32_t len = length(c);
+  for (int d = 0; d < Dim; ++d) {
+    if (p[d] != c.anchor[d] && p[d] != c.anchor[d] + len) return false;
+  }
+  return true;
+}
+
+template <int Dim> inline std::uint64_t volume_units(const Cell<Dim>& c) {
+  return std::uint64_t(1) << (Dim * (max_level<Dim> - c.level));
+}
 
 }  // namespace febemesh

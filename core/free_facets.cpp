@@ -16,11 +16,13 @@ std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> FreeFacet<Dim>::corners
 
 template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep) {
   std::vector<FreeFacet<Dim>> out;
+  const LeafKeys<Dim> keys(t);
+  std::vector<std::size_t> nb;
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!keep[i]) continue;
     const Cell<Dim>& c = t.leaf(i);
     for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
-      const std::vector<std::size_t> nb = face_neighbours(t, i, f);
+      keys.face_neighbours(i, f, nb);
       if (nb.empty()) {
         out.push_back({i, f, c});
         continue;

@@ -55,6 +55,10 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   }
 
   // The leaves touching node p are those containing the 2^Dim finest lattice cells around p.
+  const LeafKeys<Dim> leaf_keys(t);
+  // Nodes come in Morton order, so each of the 2^Dim cells around them moves little in the
+  // leaves' Morton order from one node to the next: its search starts at its previous answer.
+  std::array<std::size_t, n_corners> hint{};
   nodes.hanging.assign(keys.size(), 0);
   for (std::size_t n = 0; n < nodes.points.size(); ++n) {
     const LatticePoint<Dim>& p = nodes.points[n];
@@ -70,7 +74,8 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
         }
       }
       if (!inside) continue;
-      const std::size_t j = locate(t, q);
+      const std::size_t j = leaf_keys.locate_near(q, hint[o]);
+      if (j != no_leaf) hint[o] = j;
       if (j != no_leaf && kept(j) && !is_corner(t.leaf(j), p)) nodes.hanging[n] = 1;
     }
   }

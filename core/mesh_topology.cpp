@@ -3,6 +3,7 @@
 #include "core/mesh_topology.hpp"
 
 #include <algorithm>
+#include <limits>
 
 #include "core/error.hpp"
 
@@ -223,29 +224,72 @@ std::vector<FacetUse> facet_uses_ref(const Elements& els) {
 }
 
 // The facets used once are flagged by (element, local facet) and read back in that order.
+// Memory, this ran at the pipeline's peak: a use is 12 bytes, its (element, local facet) packed
+// and its second and third smallest nodes, bucketed by its smallest node (counting sort); the
+// full key is recomputed only when two uses agree on three nodes that are not -1 (faces of 4
+// nodes). Which keys occur once does not depend on the order within a bucket.
 std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
-  const std::vector<FacetUse> uses = facet_uses(solid);
-  std::vector<std::size_t> first(solid.size() + 1, 0);
-  for (std::size_t e = 0; e < solid.size(); ++e) first[e + 1] = first[e] + static_cast<std::size_t>(n_facets(solid.type[e]));
-  std::vector<std::uint8_t> once(first.back(), 0);
-  std::size_t n_once = 0;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    if (j - i == 1) {
-      once[first[uses[i].elem.v] + static_cast<std::size_t>(uses[i].local)] = 1;
-      ++n_once;
+  constexpr int facet_bits = 3;  // at most 6 facets per element
+  if (solid.size() >= (std::size_t(1) << (32 - facet_bits)))
+    throw LimitError("boundary_facets: " + std::to_string(solid.size()) + " elements exceed packed 32-bit facet ids");
+  struct Use {
+    std::uint32_t id;     ///< element << facet_bits | local facet
+    std::int32_t second;  ///< key.v[1]
+    std::int32_t third;   ///< key.v[2]; -1 for an edge, and then key.v[3] is -1 too
+  };
+  auto key = [&](std::uint32_t id) {
+    return key_of(facet_of(solid, ElemId{static_cast<std::int32_t>(id >> facet_bits)}, static_cast<int>(id & 7u)));
+  };
+  std::int64_t top = -1;
+  for (const VertexId v : solid.node) top = std::max<std::int64_t>(top, v.v);
+  // Bucket = smallest id + 1 (ids are >= -1).
+  std::vector<std::uint32_t> start(static_cast<std::size_t>(top + 3), 0);
+  std::size_t n_uses = 0;
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (int f = 0; f < n_facets(solid.type[e]); ++f, ++n_uses)
+      ++start[static_cast<std::size_t>(key((std::uint32_t(e) << facet_bits) | std::uint32_t(f)).v[0] + 2)];
+  if (n_uses > std::numeric_limits<std::uint32_t>::max())
+    throw LimitError("boundary_facets: " + std::to_string(n_uses) + " facet uses exceed 32-bit indices");
+  for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+  std::vector<Use> uses(n_uses);
+  for (std::size_t e = 0; e < solid.size(); ++e)
+    for (int f = 0; f < n_facets(solid.type[e]); ++f) {
+      const std::uint32_t id = (std::uint32_t(e) << facet_bits) | std::uint32_t(f);
+      const FacetKey k = key(id);
+      uses[start[static_cast<std::size_t>(k.v[0] + 1)]++] = {id, k.v[1], k.v[2]};
     }
-    i = j;
+  // start[b] is now the end of bucket b.
+  std::vector<std::uint8_t> once(solid.size() << facet_bits, 0);
+  std::size_t n_once = 0, lo = 0;
+  for (std::size_t b = 0; b + 1 < start.size(); ++b) {
+    const std::size_t hi = start[b];
+    auto less = [&](const Use& x, const Use& y) {
+      if (x.second != y.second) return x.second < y.second;
+      if (x.third != y.third) return x.third < y.third;
+      return x.third >= 0 && key(x.id).v[3] < key(y.id).v[3];
+    };
+    auto same = [&](const Use& x, const Use& y) {
+      return x.second == y.second && x.third == y.third && (x.third < 0 || key(x.id).v[3] == key(y.id).v[3]);
+    };
+    std::sort(uses.begin() + static_cast<std::ptrdiff_t>(lo), uses.begin() + static_cast<std::ptrdiff_t>(hi), less);
+    for (std::size_t i = lo; i < hi;) {
+      std::size_t j = i + 1;
+      while (j < hi && same(uses[j], uses[i])) ++j;
+      if (j - i == 1) {
+        once[uses[i].id] = 1;
+        ++n_once;
+      }
+      i = j;
+    }
+    lo = hi;
   }
   std::vector<BoundaryFacet> out;
   out.reserve(n_once);
   for (std::size_t e = 0; e < solid.size(); ++e)
-    for (std::size_t f = first[e]; f < first[e + 1]; ++f) {
-      if (!once[f]) continue;
+    for (int f = 0; f < n_facets(solid.type[e]); ++f) {
+      if (!once[(e << facet_bits) | std::size_t(f)]) continue;
       const ElemId id{static_cast<std::int32_t>(e)};
-      const int local = static_cast<int>(f - first[e]);
-      out.push_back({facet_of(solid, id, local), id, local});
+      out.push_back({facet_of(solid, id, f), id, f});
     }
   return out;
 }

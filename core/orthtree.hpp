@@ -144,8 +144,27 @@ template <int Dim> std::size_t find_covering_leaf(const Orthtree<Dim>& t, const 
 /// size or coarser; the 2^(Dim-1) (or more, if unbalanced) finer leaves touching the facet,
 /// in Morton order.
 template <int Dim> std::vector<std::size_t> face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f);
+/// The same into `out` (cleared first): loops over every facet reuse one vector.
+template <int Dim> void face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f, std::vector<std::size_t>& out);
 /// Leaves whose closed boxes overlap the closed real box `b`, in Morton order.
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b);
+
+/// The same queries (same answers) on a flat copy of the leaves' Morton keys, for loops that ask
+/// many of them of one tree: a probe of the binary search reads a key instead of computing one.
+/// The tree must outlive this and stay unchanged.
+template <int Dim> class LeafKeys {
+ public:
+  explicit LeafKeys(const Orthtree<Dim>& t);
+  std::size_t find_covering_leaf(const Cell<Dim>& c) const;
+  std::size_t locate(const LatticePoint<Dim>& p) const;
+  /// locate, searching outward from leaf `hint` (O(log distance); e.g. the previous answer).
+  std::size_t locate_near(const LatticePoint<Dim>& p, std::size_t hint) const;
+  void face_neighbours(std::size_t i, int f, std::vector<std::size_t>& out) const;
+
+ private:
+  const Orthtree<Dim>* tree_;
+  std::vector<std::uint64_t> keys_;
+};
 
 /// The unique lattice nodes of the (kept) leaves.
 template <int Dim> struct LatticeNodes {

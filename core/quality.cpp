@@ -173,6 +173,17 @@ template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>
   return std::clamp(m * normalisation(t), -1.0, 1.0);
 }
 
+template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p) {
+  if (t == ElemType::Line2) return {min_corner_jacobian<Dim>(t, p), scaled_jacobian<Dim>(t, p)};
+  double m = inf, s = inf;
+  for (const Corner& k : corners(t)) {
+    const auto [jac, lengths] = corner_jacobian<Dim>(t, k, p);
+    m = std::min(m, jac);
+    s = std::min(s, lengths > 0.0 ? jac / lengths : 0.0);
+  }
+  return {m, std::clamp(s * normalisation(t), -1.0, 1.0)};
+}
+
 template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>> p) {
   switch (t) {
     case ElemType::Line2: return (p[1] - p[0]).norm();
@@ -332,6 +343,7 @@ template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh) {
 #define FEBEMESH_INSTANTIATE(D)                                                                     \
   template double min_corner_jacobian<D>(ElemType, std::span<const Point<D>>);                     \
   template double scaled_jacobian<D>(ElemType, std::span<const Point<D>>);                         \
+  template std::pair<double, double> jacobians<D>(ElemType, std::span<const Point<D>>);           \
   template double signed_measure<D>(ElemType, std::span<const Point<D>>);                          \
   template ElementQuality element_quality<D>(ElemType, std::span<const Point<D>>);                 \
   template ElemPoints<D> element_points<D>(const Elements&, ElemId, const std::vector<Point<D>>&); \

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstddef>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -28,6 +29,9 @@ template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<
 /// Verdict scaled Jacobian: min over corners of J / (product of corner edge lengths), times
 /// 2/sqrt(3) (tri, prism), sqrt(2) (tet, pyramid), 1 (quad, hex); clamped to [-1, 1].
 template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>> p);
+/// Both at once, {min_corner_jacobian, scaled_jacobian} (the same values; one pass over the
+/// corners, for the smoothing guard that needs both per trial move).
+template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p);
 /// Signed length / area / volume (unsigned for an element of lower dimension than Dim).
 template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>> p);
 template <int Dim> ElementQuality element_quality(ElemType t, std::span<const Point<Dim>> p);

@@ -51,8 +51,6 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   const std::size_t n = mesh.points.size();
   MESH_ASSERT(options.fixed.empty() || options.fixed.size() == n, "fixed has " << options.fixed.size() << " entries");
   SmoothStats stats;
-  const std::vector<double> q0 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
-  stats.min_quality_before = q0.empty() ? 0.0 : *std::min_element(q0.begin(), q0.end());
 
   const Csr neighbours = build_csr(n, both_ways(unique_edges(mesh.solid)));
   Elements boundary;
@@ -71,14 +69,21 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
 
   auto element_state = [&](std::int32_t e) {
     const auto ep = element_points<Dim>(mesh.solid, ElemId{e}, mesh.points);
-    const ElemType t = mesh.solid.type[e];
-    return std::pair{min_corner_jacobian<Dim>(t, ep.span()) > 0.0, scaled_jacobian<Dim>(t, ep.span())};
+    const auto [jac, scaled] = jacobians<Dim>(mesh.solid.type[e], ep.span());
+    return std::pair{jac > 0.0, scaled};
+  };
+  // The scaled Jacobians of `state` are those of the current points (before and after).
+  auto min_quality = [&](const std::vector<std::pair<bool, double>>& st) {
+    double q = std::numeric_limits<double>::infinity();
+    for (const auto& s : st) q = std::min(q, s.second);
+    return st.empty() ? 0.0 : q;
   };
 
   // The state of every element, refreshed where a move is accepted: the guard compares against
   // it instead of re-evaluating the incident elements before each move (same values).
   std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
+  stats.min_quality_before = min_quality(state);
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
     for (std::size_t v = 0; v < n; ++v) {
@@ -95,18 +100,22 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       if (target == mesh.points[v]) continue;
 
       double old_min = std::numeric_limits<double>::infinity();
-      for (const auto e : elems) old_min = std::min(old_min, state[e].second);
+      std::size_t worst = 0;
+      for (std::size_t k = 0; k < elems.size(); ++k) {
+        if (state[elems[k]].second < old_min) worst = k;
+        old_min = std::min(old_min, state[elems[k]].second);
+      }
       const Point<Dim> saved = mesh.points[v];
       mesh.points[v] = target;
+      // Accepted iff no valid element inverts and every element stays >= old_min: the first
+      // element that fails decides, the element that held old_min (likeliest to drop) first.
       bool accept = true;
-      double new_min = std::numeric_limits<double>::infinity();
-      after.clear();
-      for (std::size_t k = 0; k < elems.size() && accept; ++k) {
-        after.push_back(element_state(elems[k]));
-        accept = after.back().first || !state[elems[k]].first;
-        new_min = std::min(new_min, after.back().second);
+      after.resize(elems.size());
+      for (std::size_t j = 0; j < elems.size() && accept; ++j) {
+        const std::size_t k = j == 0 ? worst : (j <= worst ? j - 1 : j);
+        after[k] = element_state(elems[k]);
+        accept = (after[k].first || !state[elems[k]].first) && after[k].second >= old_min;
       }
-      accept = accept && new_min >= old_min;
       if (accept) {
         ++stats.moves_accepted;
         for (std::size_t k = 0; k < elems.size(); ++k) state[elems[k]] = after[k];
@@ -116,8 +125,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       }
     }
   }
-  const std::vector<double> q1 = scaled_jacobians<Dim>(mesh.solid, mesh.points);
-  stats.min_quality_after = q1.empty() ? 0.0 : *std::min_element(q1.begin(), q1.end());
+  stats.min_quality_after = min_quality(state);
   return stats;
 }
 

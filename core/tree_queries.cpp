@@ -10,43 +10,151 @@
 namespace febemesh {
 namespace {
 
+/// Morton keys of the leaves as an indexable sequence: computed from the cells (Orthtree) or
+/// read from a flat array (LeafKeys). The searches below are the same for both.
+template <int Dim> struct CellKeys {
+  const Orthtree<Dim>& t;
+  std::uint64_t operator[](std::size_t i) const { return morton_key(t.leaf(i)); }
+  std::size_t size() const { return t.n_leaves(); }
+};
+struct FlatKeys {
+  const std::vector<std::uint64_t>& k;
+  std::uint64_t operator[](std::size_t i) const { return k[i]; }
+  std::size_t size() const { return k.size(); }
+};
+
+/// std::upper_bound / std::lower_bound over keys[lo, hi).
+template <class Keys> std::size_t upper_bound_key(const Keys& keys, std::size_t lo, std::size_t hi, std::uint64_t key) {
+  for (std::size_t n = hi - lo; n > 0;) {
+    const std::size_t half = n / 2;
+    if (!(key < keys[lo + half])) {
+      lo += half + 1;
+      n -= half + 1;
+    } else {
+      n = half;
+    }
+  }
+  return lo;
+}
+template <class Keys> std::size_t lower_bound_key(const Keys& keys, std::size_t lo, std::size_t hi, std::uint64_t key) {
+  for (std::size_t n = hi - lo; n > 0;) {
+    const std::size_t half = n / 2;
+    if (keys[lo + half] < key) {
+      lo += half + 1;
+      n -= half + 1;
+    } else {
+      n = half;
+    }
+  }
+  return lo;
+}
+
+/// upper_bound_key over all keys, searched outward from `hint` (galloping, then binary search):
+/// O(log distance), the same answer. Successive queries at nearby keys pass the previous one.
+template <class Keys> std::size_t upper_bound_near(const Keys& keys, std::size_t hint, std::uint64_t key) {
+  const std::size_t n = keys.size();
+  if (hint > n) hint = n;
+  std::size_t lo = 0, hi = n, step = 1;
+  if (hint < n && !(key < keys[hint])) {  // the answer is after hint
+    lo = hint + 1;
+    for (;;) {
+      const std::size_t probe = lo - 1 + step;
+      if (probe >= n) {
+        hi = n;
+        break;
+      }
+      if (key < keys[probe]) {
+        hi = probe;
+        break;
+      }
+      lo = probe + 1;
+      step *= 2;
+    }
+  } else {  // the answer is at or before hint
+    hi = hint;
+    for (;;) {
+      if (hi == 0) return 0;
+      const std::size_t probe = hi >= step ? hi - step : 0;
+      if (key < keys[probe]) {
+        hi = probe;
+        step *= 2;
+      } else {
+        lo = probe + 1;
+        break;
+      }
+    }
+  }
+  return upper_bound_key(keys, lo, hi, key);
+}
+
 /// Index of the last leaf whose Morton key is <= key, or no_leaf. In a linear tree at most one
 /// leaf has a given key, so this is the only candidate to contain a cell anchored at `key`.
-template <int Dim> std::size_t last_at_or_before(const Orthtree<Dim>& t, std::uint64_t key) {
-  const auto& L = t.leaves();
-  const auto it = std::upper_bound(L.begin(), L.end(), key, [](std::uint64_t k, const Cell<Dim>& c) {
-    return k < morton_key(c);
-  });
-  if (it == L.begin()) return no_leaf;
-  return std::size_t(it - L.begin()) - 1;
+template <class Keys> std::size_t last_at_or_before(const Keys& keys, std::uint64_t key) {
+  const std::size_t it = upper_bound_key(keys, 0, keys.size(), key);
+  if (it == 0) return no_leaf;
+  return it - 1;
 }
 
 /// First leaf with Morton key >= key.
-template <int Dim> std::size_t first_at_or_after(const Orthtree<Dim>& t, std::uint64_t key) {
-  const auto& L = t.leaves();
-  return std::size_t(std::lower_bound(L.begin(), L.end(), key, [](const Cell<Dim>& c, std::uint64_t k) {
-                       return morton_key(c) < k;
-                     }) - L.begin());
+template <class Keys> std::size_t first_at_or_after(const Keys& keys, std::uint64_t key) {
+  return lower_bound_key(keys, 0, keys.size(), key);
 }
 
 template <int Dim> bool contains_or_equals(const Cell<Dim>& a, const Cell<Dim>& c) {
   return a == c || is_ancestor(a, c);
 }
 
+template <int Dim, class Keys> std::size_t covering_leaf(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c) {
+  const std::size_t j = last_at_or_before(keys, morton_key(c));
+  if (j == no_leaf || !contains_or_equals(t.leaf(j), c)) return no_leaf;
+  return j;
+}
+
+/// The same searched from a hint (upper_bound_near).
+template <int Dim, class Keys>
+std::size_t covering_leaf_near(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c, std::size_t hint) {
+  const std::size_t it = upper_bound_near(keys, hint, morton_key(c));
+  if (it == 0 || !contains_or_equals(t.leaf(it - 1), c)) return no_leaf;
+  return it - 1;
+}
+
+template <int Dim, class Keys> std::size_t leaf_at(const Orthtree<Dim>& t, const Keys& keys, const LatticePoint<Dim>& p) {
+  for (int d = 0; d < Dim; ++d) {
+    if (p[d] >= root_length<Dim>) return no_leaf;
+  }
+  Cell<Dim> unit;
+  unit.anchor = p;
+  unit.level = std::uint8_t(max_level<Dim>);
+  return covering_leaf(t, keys, unit);
+}
+
 /// Leaves inside cell c that touch its facet on side `side` of `axis`, depth first in Morton order.
-template <int Dim>
-void facet_leaves(const Orthtree<Dim>& t, const Cell<Dim>& c, int axis, int side, std::vector<std::size_t>& out) {
-  const std::size_t j = find_covering_leaf(t, c);
+template <int Dim, class Keys>
+void facet_leaves(const Orthtree<Dim>& t, const Keys& keys, const Cell<Dim>& c, int axis, int side,
+                  std::vector<std::size_t>& out, std::size_t hint) {
+  const std::size_t j = hint == no_leaf ? covering_leaf(t, keys, c) : covering_leaf_near(t, keys, c, hint);
   if (j != no_leaf) {
     out.push_back(j);
     return;
   }
   // Stop where c holds no leaf at all (only in an incomplete tree).
-  const std::size_t first = first_at_or_after(t, morton_key(c));
-  if (first == t.n_leaves() || morton_key(t.leaf(first)) >= morton_key(c) + volume_units(c)) return;
+  const std::size_t first = first_at_or_after(keys, morton_key(c));
+  if (first == t.n_leaves() || keys[first] >= morton_key(c) + volume_units(c)) return;
   for (int i = 0; i < Cube<Dim>::n_children; ++i) {
-    if (int((i >> axis) & 1) == side) facet_leaves(t, child(c, i), axis, side, out);
+    if (int((i >> axis) & 1) == side) facet_leaves(t, keys, child(c, i), axis, side, out, hint);
   }
+}
+
+template <int Dim, class Keys>
+void neighbours_across(const Orthtree<Dim>& t, const Keys& keys, std::size_t i, int f, std::vector<std::size_t>& out,
+                       std::size_t hint = no_leaf) {
+  MESH_ASSERT(i < t.n_leaves(), "leaf " << i << " of " << t.n_leaves());
+  MESH_ASSERT(f >= 0 && f < Cube<Dim>::n_faces, "facet " << f);
+  out.clear();
+  Cell<Dim> n;
+  if (!face_neighbour(t.leaf(i), f, n)) return;
+  // The neighbour's leaves that touch leaf i lie on n's facet facing back: the opposite side.
+  facet_leaves(t, keys, n, face_axis(f), 1 - face_side(f), out, hint);
 }
 
 template <int Dim>
@@ -78,13 +186,7 @@ void box_leaves(const Orthtree<Dim>& t, const Cell<Dim>& c, std::size_t lo, std:
 }  // namespace
 
 template <int Dim> std::size_t locate(const Orthtree<Dim>& t, const LatticePoint<Dim>& p) {
-  for (int d = 0; d < Dim; ++d) {
-    if (p[d] >= root_length<Dim>) return no_leaf;
-  }
-  Cell<Dim> unit;
-  unit.anchor = p;
-  unit.level = std::uint8_t(max_level<Dim>);
-  return find_covering_leaf(t, unit);
+  return leaf_at(t, CellKeys<Dim>{t}, p);
 }
 
 template <int Dim> std::size_t locate(const Orthtree<Dim>& t, const Point<Dim>& x) {
@@ -100,20 +202,44 @@ template <int Dim> std::size_t locate(const Orthtree<Dim>& t, const Point<Dim>& 
 }
 
 template <int Dim> std::size_t find_covering_leaf(const Orthtree<Dim>& t, const Cell<Dim>& c) {
-  const std::size_t j = last_at_or_before(t, morton_key(c));
-  if (j == no_leaf || !contains_or_equals(t.leaf(j), c)) return no_leaf;
-  return j;
+  return covering_leaf(t, CellKeys<Dim>{t}, c);
 }
 
 template <int Dim> std::vector<std::size_t> face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f) {
-  MESH_ASSERT(i < t.n_leaves(), "leaf " << i << " of " << t.n_leaves());
-  MESH_ASSERT(f >= 0 && f < Cube<Dim>::n_faces, "facet " << f);
   std::vector<std::size_t> out;
-  Cell<Dim> n;
-  if (!face_neighbour(t.leaf(i), f, n)) return out;
-  // The neighbour's leaves that touch leaf i lie on n's facet facing back: the opposite side.
-  facet_leaves(t, n, face_axis(f), 1 - face_side(f), out);
+  neighbours_across(t, CellKeys<Dim>{t}, i, f, out);
   return out;
+}
+
+template <int Dim> void face_neighbours(const Orthtree<Dim>& t, std::size_t i, int f, std::vector<std::size_t>& out) {
+  neighbours_across(t, CellKeys<Dim>{t}, i, f, out);
+}
+
+template <int Dim> LeafKeys<Dim>::LeafKeys(const Orthtree<Dim>& t) : tree_(&t), keys_(t.n_leaves()) {
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) keys_[i] = morton_key(t.leaf(i));
+}
+
+template <int Dim> std::size_t LeafKeys<Dim>::find_covering_leaf(const Cell<Dim>& c) const {
+  return covering_leaf(*tree_, FlatKeys{keys_}, c);
+}
+
+template <int Dim> std::size_t LeafKeys<Dim>::locate(const LatticePoint<Dim>& p) const {
+  return leaf_at(*tree_, FlatKeys{keys_}, p);
+}
+
+template <int Dim> std::size_t LeafKeys<Dim>::locate_near(const LatticePoint<Dim>& p, std::size_t hint) const {
+  for (int d = 0; d < Dim; ++d) {
+    if (p[d] >= root_length<Dim>) return no_leaf;
+  }
+  Cell<Dim> unit;
+  unit.anchor = p;
+  unit.level = std::uint8_t(max_level<Dim>);
+  return covering_leaf_near(*tree_, FlatKeys{keys_}, unit, hint);
+}
+
+template <int Dim> void LeafKeys<Dim>::face_neighbours(std::size_t i, int f, std::vector<std::size_t>& out) const {
+  // Most neighbours are near leaf i in Morton order: the searches start there.
+  neighbours_across(*tree_, FlatKeys{keys_}, i, f, out, i);
 }
 
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b) {
@@ -127,7 +253,9 @@ template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t
   template std::size_t locate<D>(const Orthtree<D>&, const LatticePoint<D>&);                 \
   template std::size_t find_covering_leaf<D>(const Orthtree<D>&, const Cell<D>&);             \
   template std::vector<std::size_t> face_neighbours<D>(const Orthtree<D>&, std::size_t, int); \
-  template std::vector<std::size_t> leaves_in_box<D>(const Orthtree<D>&, const Box<D>&);
+  template void face_neighbours<D>(const Orthtree<D>&, std::size_t, int, std::vector<std::size_t>&); \
+  template std::vector<std::size_t> leaves_in_box<D>(const Orthtree<D>&, const Box<D>&);     \
+  template class LeafKeys<D>;
 
 FEBEMESH_INSTANTIATE_QUERIES(2)
 FEBEMESH_INSTANTIATE_QUERIES(3)

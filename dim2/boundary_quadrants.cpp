@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <sstream>
+#include <unordered_map>
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
@@ -68,6 +69,15 @@ struct Projector {
   /// Closest point of the curve to q whose segment is admissible (paper: the shortest normal,
   /// then the next normals, then walking along the curve from the closest point).
   bool project(const Point<2>& q, double h, ClosestPoint<2>& out) {
+    // closest_points starts with closest_point, which is almost always admissible: only then
+    // are the other local minima (a search over every piece) needed.
+    if (opt.max_normals > 0) {
+      const ClosestPoint<2> nearest = curve.closest_point(q);
+      if (admissible(q, nearest.point)) {
+        out = nearest;
+        return true;
+      }
+    }
     const std::vector<ClosestPoint<2>> cands = curve.closest_points(q, opt.max_normals);
     for (std::size_t k = 0; k < cands.size(); ++k) {
       if (admissible(q, cands[k].point)) {
@@ -148,6 +158,15 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
   std::size_t removed = 0;
   FreeEdges facets;
   bool fresh = false;  // `facets` is free_facets(t, in)
+  // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
+  // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
+  // names its edge: edges of different lengths or axes never share one.
+  std::unordered_map<std::uint64_t, double> corner_distance, midpoint_distance;
+  auto cached = [&](std::unordered_map<std::uint64_t, double>& cache, std::uint64_t key, const Point<2>& p) {
+    const auto [it, added] = cache.try_emplace(key, 0.0);
+    if (added) it->second = curve.closest_point(p).distance;
+    return it->second;
+  };
   for (int pass = 0; pass < 4; ++pass) {
     facets = free_facets(t, in);
     fresh = true;
@@ -156,8 +175,10 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
       const auto c = f.corners();
       const double h = facet_length(t, f);
       const Point<2> a = position(t, c[0]), b = position(t, c[1]);
-      const double d = std::min({curve.closest_point(a).distance, curve.closest_point(b).distance,
-                                 curve.closest_point(0.5 * (a + b)).distance});
+      const LP doubled{c[0][0] + c[1][0], c[0][1] + c[1][1]};
+      const double d = std::min({cached(corner_distance, point_key<2>(c[0]), a),
+                                 cached(corner_distance, point_key<2>(c[1]), b),
+                                 cached(midpoint_distance, point_key<2>(doubled), 0.5 * (a + b))});
       if (d < fraction * h) drop.push_back(f.leaf);
     }
     std::sort(drop.begin(), drop.end());
@@ -177,6 +198,14 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   QuadrantComplex& qc = res.complex;
   const LatticeNodes<2> nodes = lattice_nodes(t, &in);
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
+  // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
+  std::vector<std::uint64_t> node_keys(nodes.points.size());
+  for (std::size_t k = 0; k < nodes.points.size(); ++k) node_keys[k] = point_key<2>(nodes.points[k]);
+  auto find_node = [&](const LP& p) {
+    const std::uint64_t key = point_key<2>(p);
+    const auto it = std::lower_bound(node_keys.begin(), node_keys.end(), key);
+    return it != node_keys.end() && *it == key ? std::int32_t(it - node_keys.begin()) : std::int32_t(-1);
+  };
 
   // Interior quadrants: CCW rings with hanging mid-edge nodes.
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
@@ -188,9 +217,9 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     for (int k = 0; k < 4; ++k) {
       const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
       q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
-      q.ring.push_back(nodes.find(a));
+      q.ring.push_back(find_node(a));
       if (length(c) >= 2) {
-        const std::int32_t m = nodes.find(midpoint(a, b));
+        const std::int32_t m = find_node(midpoint(a, b));
         if (m >= 0) q.ring.push_back(m);
       }
     }
@@ -205,7 +234,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   std::vector<std::array<std::int32_t, 2>> ends(facets.size());
   for (std::size_t k = 0; k < facets.size(); ++k) {
     const auto c = facets[k].corners();
-    ends[k] = {nodes.find(c[0]), nodes.find(c[1])};
+    ends[k] = {find_node(c[0]), find_node(c[1])};
     MESH_ASSERT(ends[k][0] >= 0 && ends[k][1] >= 0, "free edge corner is not a node");
     if (next_facet[ends[k][0]] >= 0) {
       res.problems.push_back({qc.points[ends[k][0]], "interior quadrants meet only at a vertex"});

@@ -246,20 +246,28 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
       double old_q = 180.0;
-      for (const std::int32_t e : elems) old_q = std::min(old_q, angle[e]);
+      std::size_t worst = 0;
+      for (std::size_t k = 0; k < elems.size(); ++k) {
+        if (angle[elems[k]] < old_q) worst = k;
+        old_q = std::min(old_q, angle[elems[k]]);
+      }
       const P2 saved = m.points[v];
       bool moved = false;
+      trial.resize(elems.size());
       for (double step : {1.0, 0.5, 0.25}) {
         m.points[v] = saved + step * (target - saved);
         if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
         if (m.points[v] == saved) break;
-        double q = 180.0;
-        trial.clear();
-        for (const std::int32_t e : elems) {
-          trial.push_back(min_corner_angle_deg(m, e));
-          q = std::min(q, trial.back());
+        // Accepted iff every incident element's angle exceeds old_q + 1e-12. The first one
+        // that does not rejects the step and the others need not be evaluated; the element
+        // that held old_q is the likeliest to fail, so it goes first.
+        bool better = true;
+        for (std::size_t j = 0; j < elems.size() && better; ++j) {
+          const std::size_t k = j == 0 ? worst : (j <= worst ? j - 1 : j);
+          trial[k] = min_corner_angle_deg(m, static_cast<std::size_t>(elems[k]));
+          better = trial[k] > old_q + 1e-12;
         }
-        if (q > old_q + 1e-12) {
+        if (better) {
           moved = true;
           break;
         }

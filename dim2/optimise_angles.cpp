@@ -39,12 +39,6 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
                                    const AngleOptimiseOptions& opt, const SlideFn& slide) {
   AngleOptimiseStats st;
   const std::size_t n_nodes = m.points.size(), n_elems = m.solid.size();
-  auto mesh_worst = [&] {
-    double q = 1e300;
-    for (std::size_t e = 0; e < n_elems; ++e) q = std::min(q, angle_quality(m, e));
-    return n_elems ? q : 0.0;
-  };
-  st.worst_before = mesh_worst();
 
   // Node -> incident elements (CSR) and node -> edge neighbours (CSR, sorted, unique).
   std::vector<std::int32_t> first(n_nodes + 1, 0);
@@ -54,48 +48,58 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   }
   for (std::size_t v = 0; v < n_nodes; ++v) first[v + 1] += first[v];
   std::vector<std::int32_t> incident(first.back()), fill(first.begin(), first.end() - 1);
+  for (std::size_t e = 0; e < n_elems; ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
+  }
+  // Edge neighbours of each node from its incident elements (each node's few, sorted locally).
   std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
-  {
-    std::vector<std::array<std::int32_t, 2>> pairs;
-    for (std::size_t e = 0; e < n_elems; ++e) {
-      const ElemId id{static_cast<std::int32_t>(e)};
+  nbr.reserve(first.back());
+  for (std::size_t v = 0; v < n_nodes; ++v) {
+    const std::size_t begin = nbr.size();
+    for (std::int32_t k = first[v]; k < first[v + 1]; ++k) {
+      const ElemId id{incident[k]};
       const int n = m.solid.n_nodes_of(id);
-      const VertexId* v = m.solid.nodes(id);
-      for (int k = 0; k < n; ++k) {
-        incident[fill[v[k].v]++] = static_cast<std::int32_t>(e);
-        pairs.push_back({v[k].v, v[(k + 1) % n].v});
-        pairs.push_back({v[(k + 1) % n].v, v[k].v});
+      const VertexId* ev = m.solid.nodes(id);
+      for (int j = 0; j < n; ++j) {
+        if (ev[j].v != static_cast<std::int32_t>(v)) continue;
+        nbr.push_back(ev[(j + 1) % n].v);
+        nbr.push_back(ev[(j + n - 1) % n].v);
       }
     }
-    std::sort(pairs.begin(), pairs.end());
-    pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-    nbr.reserve(pairs.size());
-    for (const auto& pr : pairs) {
-      ++nbr_first[pr[0] + 1];
-      nbr.push_back(pr[1]);
-    }
-    for (std::size_t v = 0; v < n_nodes; ++v) nbr_first[v + 1] += nbr_first[v];
+    std::sort(nbr.begin() + std::ptrdiff_t(begin), nbr.end());
+    nbr.erase(std::unique(nbr.begin() + std::ptrdiff_t(begin), nbr.end()), nbr.end());
+    nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
   }
 
-  auto local_worst = [&](std::size_t v) {
+  // Worst q around v, or any value <= floor once it is known to be <= floor (the caller only
+  // asks whether it beats floor).
+  auto local_worst = [&](std::size_t v, double floor) {
     double q = 1e300;
-    for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q = std::min(q, angle_quality(m, incident[k]));
+    for (std::int32_t k = first[v]; k < first[v + 1] && q > floor; ++k) q = std::min(q, angle_quality(m, incident[k]));
     return q;
   };
   // The q of every element, refreshed when one of its nodes moves: most nodes are already
   // above the target and are skipped on these cached values (the same numbers).
   std::vector<double> q_elem(n_elems);
   for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = angle_quality(m, e);
+  // q_elem is refreshed wherever a node moves, so it is the mesh's q before and after.
+  auto mesh_worst = [&] {
+    double q = 1e300;
+    for (const double qe : q_elem) q = std::min(q, qe);
+    return n_elems ? q : 0.0;
+  };
+  st.worst_before = mesh_worst();
   auto cached_worst = [&](std::size_t v) {
     double q = 1e300;
     for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q = std::min(q, q_elem[incident[k]]);
     return q;
   };
-  // Worst q with node v at p (the node is put back afterwards).
-  auto worst_at = [&](std::size_t v, const P2& p) {
+  // local_worst with node v at p (the node is put back afterwards).
+  auto worst_at = [&](std::size_t v, const P2& p, double floor) {
     const P2 keep = m.points[v];
     m.points[v] = p;
-    const double q = local_worst(v);
+    const double q = local_worst(v, floor);
     m.points[v] = keep;
     return q;
   };
@@ -131,7 +135,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       auto consider = [&](const P2& target) {
         const P2 p = place(target);
         if (p == best) return false;
-        const double q = worst_at(v, p);
+        const double q = worst_at(v, p, best_q);
         if (q <= best_q) return false;
         best_q = q;
         best = p;

@@ -96,6 +96,9 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       // Quad = the mixed mesh smoothed and improved, then split once and optimised.
       const ElementKind base = opt.elements == ElementKind::Quad ? ElementKind::Mixed : opt.elements;
       fe = fe_be_mesh(bq.complex, base, midpoint);
+      // The complex is kept only for the figures (and the quad split only adds elements): free
+      // it before smoothing, the run's memory peak, when they will not be drawn.
+      if (!opt.keep_stages || fe.mesh.solid.size() > opt.keep_stages_max_elements) bq.complex = QuadrantComplex();
       clock.lap("templates");
       say("smoothing: " + std::to_string(opt.smoothing_iterations) + " Laplacian iterations");
       SmoothOptions<2> so;

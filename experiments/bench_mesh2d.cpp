@@ -9,9 +9,11 @@
 //
 // Usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a.json,b.svg] [--no-gmsh] [--threads N]
 //                     [--memory-budget GB] [--gmsh-max N]
+//                     [--elements tri|quad|mixed]
 //   --memory-budget: a size whose estimated peak (bytes/element of the previous size) exceeds
 //   it is skipped with a message (default 6 GB: the machine is shared).
 //   --gmsh-max: no Gmsh run above this many elements (default 1.2e6; Gmsh takes ~30 s per 10^6).
+//   --elements: tri (default), quad or mixed.
 //   --levels: run these levels instead of fitting levels to --sizes (the element count is a step
 //   function of the level on some inputs, e.g. the flange jumps from 85k at 8 to 340k at 8.23,
 //   so the fit can miss its target by 3x; then name the levels).
@@ -72,6 +74,7 @@ int main(int argc, char** argv) {
   std::vector<double> levels;
   bool gmsh = true;
   int threads = 1;
+  dim2::ElementKind elements = dim2::ElementKind::Tri;
   double budget = 6e9, gmsh_max = 1.2e6;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -91,6 +94,8 @@ int main(int argc, char** argv) {
       inputs = split(next());
     } else if (a == "--no-gmsh") {
       gmsh = false;
+    } else if (a == "--elements") {
+      elements = dim2::element_kind_from(next());
     } else if (a == "--threads") {
       threads = std::stoi(next());
     } else if (a == "--memory-budget") {
@@ -99,7 +104,7 @@ int main(int argc, char** argv) {
       gmsh_max = std::stod(next());
     } else {
       std::cerr << "usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a,b] [--no-gmsh] [--threads N] "
-                   "[--memory-budget GB] [--gmsh-max N] [--levels 8,9.4]\n";
+                   "[--memory-budget GB] [--gmsh-max N] [--levels 8,9.4] [--elements tri|quad|mixed]\n";
       return 2;
     }
   }
@@ -142,7 +147,7 @@ int main(int argc, char** argv) {
       }
       // Levels are real: the control level interpolates the cell size between powers of two.
       const double level = levels.empty() ? std::round(fit.level_for(target) * 100.0) / 100.0 : size_or_level;
-      const OurRun run = run_ours_2d(*base, level, threads, work / name);
+      const OurRun run = run_ours_2d(*base, level, threads, work / name, elements);
       if (!run.ok) {
         std::cout << "  " << tag << ": febemesh failed: " << run.error << "\n";
         skipped << "- " << tag << ": febemesh failed: " << run.error << "\n";

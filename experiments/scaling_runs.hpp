@@ -113,7 +113,8 @@ template <int Dim, class Body> OurRun timed_run(const fs::path& dir, Body&& body
   return run;
 }
 
-inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir) {
+inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir,
+                          dim2::ElementKind elements = dim2::ElementKind::Tri) {
   OurRun run = timed_run<2>(dir, [&] {
     dim2::CurveBoundary curve = base;
     curve.set_global_level(level);
@@ -121,6 +122,7 @@ inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int thr
     opt.level = level;
     opt.keep_stages = false;
     opt.n_threads = threads;
+    opt.elements = elements;
     dim2::Result2d r = dim2::mesh2d(curve, opt);
     return std::pair{std::move(r.fe.mesh), std::move(r.times)};
   });

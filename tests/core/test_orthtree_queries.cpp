@@ -107,6 +107,26 @@ TEMPLATE_TEST_CASE_SIG("queries agree with brute force", "[orthtree][queries][pr
       }
     }
   });
+  test::prop("LeafKeys: the same answers as the tree queries, from any hint", 60, [] {
+    const auto t = (*test::gen_recipe<Dim>()).build();
+    const LeafKeys<Dim> keys(t);
+    std::vector<std::size_t> out;
+    for (int k = 0; k < 20; ++k) {
+      const auto raw = *rc::gen::arbitrary<std::array<std::uint32_t, Dim>>();
+      LatticePoint<Dim> p;
+      for (int d = 0; d < Dim; ++d) p[d] = raw[d] % root_length<Dim>;
+      const std::size_t hint = *rc::gen::inRange<std::size_t>(0, t.n_leaves() + 2);
+      RC_ASSERT(keys.locate(p) == locate(t, p));
+      RC_ASSERT(keys.locate_near(p, hint) == locate(t, p));
+      const Cell<Dim> c = *test::gen_cell<Dim>(8);
+      RC_ASSERT(keys.find_covering_leaf(c) == find_covering_leaf(t, c));
+    }
+    for (std::size_t i = 0; i < t.n_leaves(); ++i)
+      for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+        keys.face_neighbours(i, f, out);
+        RC_ASSERT(out == face_neighbours(t, i, f));
+      }
+  });
   test::prop("leaves_in_box", 60, [] {
     const auto t = (*test::gen_recipe<Dim>()).build();
     Box<Dim> b;
