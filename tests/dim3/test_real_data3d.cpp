@@ -5,19 +5,19 @@
 // GeometryError counts as a failure too.
 //
 // Measured state (session 4, CLI, default options, 2-core shared machine):
-//   sphere966 L4  valid   25728 tets, min dihedral 27.97 deg, volume error 0.72%,  1.0 s
-//   sphere966 L5  valid  190752 tets, min dihedral 27.44 deg, volume error 0.16%, 10.5 s
-//   spool L4      valid   53508 tets, min dihedral  9.45 deg, volume error 16.9%,  2.6 s
+//   sphere966 L4  valid    25728 tets, min dihedral 27.97 deg, volume error 0.72%,  1.0 s
+//   sphere966 L5  valid   190752 tets, min dihedral 27.44 deg, volume error 0.16%, 10.5 s
+//   sphere966 L6  valid  1479648 tets, min dihedral 25.54 deg, volume error 0.04%, 44.6 s
+//   spool L4      valid    53444 tets, min dihedral  9.42 deg, volume error 17.1%,  5.9 s
 //                 (flanges thinner than 1.5 level-4 octants over 69% of the area are not meshed)
-//   spool L5      refused (inverted tets after the repairs), 96 s
+//   spool L5      refused (inverted tets after the repairs)
 //   fandisk L4    refused: folded interface triangles across thin lips (their nodes on surface
-//                 sheets 160-170 deg apart) and ~11 inverted tets left after the untangling
+//                 sheets 160-170 deg apart) and ~18 inverted tets left after the untangling
 //   rotor L4      valid but 34.5% of the volume lost: 51% of the area is on blades thinner than
 //                 half a level-4 octant; refining the surface octants gives inverted tets, and
 //                 the valid coarse mesh stands
-//   anchor L4     refused: inverted tets (2 left after the untangling on the first tree); at
-//                 level 5 valid (measured before session 4: 389374 tets, 3.76 deg, 1.5%, 52 s,
-//                 too slow for this test)
+//   anchor L4     refused: inverted tets (7 left after the untangling on the first tree); at
+//                 level 5 valid (386976 tets, 3.76 deg, 1.47%, 26.7 s: too slow for this test)
 //   elephant L4   refused: inverted tets and folded interface triangles
 // The whole [data] run is about 76 s (45 s CPU) in Release, mostly the refused shapes' repairs.
 
