@@ -210,12 +210,36 @@ struct Projector {
   const SurfaceBoundary& surface;
   double graze = 1e-9;
 
-  /// The segment from q to a surface point p enters no interior octant and does not cross the
-  /// surface before reaching p.
-  bool admissible(const P3& q, const P3& p) const {
+  double min_outward = -1.0;  // BoundaryOctantOptions
+  double min_facing = -1.0;
+
+  /// The segment from q to a surface point p (on triangle `patch`, -1 = unknown) leaves through
+  /// one of q's free faces (`dirs`, bit f = face f) and lands on a side of the surface facing
+  /// that way (leaves_outward), enters no interior octant and does not cross the surface before
+  /// reaching p.
+  bool admissible(const P3& q, const P3& p, std::uint8_t dirs = 0, std::int32_t patch = -1) const {
+    if (dirs != 0 && !leaves_outward(q, p, dirs, patch)) return false;
     if (segment_enters_kept(tree, in, q, p, graze)) return false;
     const P3 short_end = q + (1.0 - 1e-7) * (p - q);
     return !surface.segment_crosses(q, short_end);
+  }
+  /// Some free face f of q has cos(p - q, n_f) >= min_outward and cos(n_p, n_f) >= min_facing:
+  /// a projection that runs back along the interior octants, or lands on the far side of a part
+  /// thinner than the octants (the surface facing away from all of q's free faces), would fold
+  /// its boundary octant.
+  bool leaves_outward(const P3& q, const P3& p, std::uint8_t dirs, std::int32_t patch) const {
+    const P3 d = p - q;
+    const double len = d.norm();
+    if (len <= 0) return true;
+    const P3 np = patch >= 0 ? P3(surface.surface().normal(patch).normalized()) : P3(P3::Zero());
+    for (int f = 0; f < 6; ++f) {
+      if (!((dirs >> f) & 1)) continue;
+      const double sign = (f % 2) ? 1.0 : -1.0;
+      if (sign * d[f / 2] / len < min_outward) continue;
+      if (patch >= 0 && sign * np[f / 2] < min_facing) continue;
+      return true;
+    }
+    return false;
   }
 };
 
@@ -274,7 +298,7 @@ bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q
     P3 hit;
     if (!first_hit(s, q, q + reach * dir, hit)) continue;
     const ClosestPoint<3> cp = s.closest_point(hit);
-    if (!proj.admissible(q, cp.point)) continue;
+    if (!proj.admissible(q, cp.point, dirs, cp.where.patch)) continue;
     out = cp;
     out.distance = (cp.point - q).norm();
     return true;
@@ -379,19 +403,19 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
-  Projector proj{t, in, s, opt.graze};
+  Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing};
   std::map<std::tuple<double, double, double>, std::int32_t> by_point;
   std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
   for (std::int32_t q = 0; q < n_lat; ++q) {
     if (!std::isfinite(node_h[q])) continue;
     ++res.stats.n_face_nodes;
     ClosestPoint<3> cp = s.closest_point(oc.points[q]);
-    if (!proj.admissible(oc.points[q], cp.point)) {
+    if (!proj.admissible(oc.points[q], cp.point, node_dirs[q], cp.where.patch)) {
       // The next local minima of the distance, then rays along the free faces' normals.
       const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);
       std::size_t pick = cands.size();
       for (std::size_t k = 1; k < cands.size() && pick == cands.size(); ++k)
-        if (proj.admissible(oc.points[q], cands[k].point)) pick = k;
+        if (proj.admissible(oc.points[q], cands[k].point, node_dirs[q], cands[k].where.patch)) pick = k;
       if (pick < cands.size()) {
         cp = cands[pick];
         ++res.stats.n_next_normal;
@@ -432,7 +456,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   };
   const auto admissible_from_all = [&](std::int32_t p, const P3& target) {
     for (std::int32_t q : sources[p - n_lat])
-      if (!proj.admissible(oc.points[q], target)) return false;
+      if (!proj.admissible(oc.points[q], target, node_dirs[q])) return false;
     return true;
   };
 

@@ -288,6 +288,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
     std::vector<Problem3> problems = oc.problems;
 
     TetMesh fe;
+    // Set when the Escobar pass made this tree's mesh positive: the problems the old path would
+    // have reported, in case the mesh turns out not to be conforming after all.
+    std::optional<std::vector<Problem3>> before_escobar;
     if (problems.empty()) {
       say("finite elements: templates");
       // Feature snaps that invert an element are undone, then the templates are redone.
@@ -305,8 +308,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
           const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
           r.n_untangle_moves += ts.moves;
           say("untangling: inverted tetrahedra " + std::to_string(ts.inverted_before) + " -> " +
-              std::to_string(ts.inverted_after) + ", folded interface triangles " + std::to_string(ts.folded_before) +
-              " -> " + std::to_string(ts.folded_after));
+              std::to_string(ts.inverted_after) + " (" + std::to_string(ts.sweeps) +
+              " sweeps), folded interface triangles " + std::to_string(ts.folded_before) + " -> " +
+              std::to_string(ts.folded_after));
         }
         const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
         const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s);
@@ -325,8 +329,33 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
           const std::size_t moved = round < opt.untangle_rounds + 4 ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
           r.n_untangled += moved;
           if (moved == 0) {
-            for (std::size_t e : bad) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
-            for (std::size_t f : folded) problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
+            // Last resort on this tree: where no node move raises the worst tetrahedron, the
+            // smooth Escobar objective still descends (tet_optimize). Only here, so that the
+            // meshes the max-min untangling already makes valid stay bit for bit the same.
+            std::vector<std::size_t> bad2 = bad, folded2 = folded;
+            if (opt.escobar_sweeps > 0) {
+              std::vector<Problem3> old_problems;
+              for (std::size_t e : bad) old_problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
+              for (std::size_t f : folded) old_problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
+              TetOptimizeOptions to;
+              to.untangle_only = true;
+              to.escobar = true;
+              to.max_sweeps = opt.escobar_sweeps;
+              to.fixed = fixed_nodes(oc.complex, fe, false);
+              to.project = surface_point;
+              to.surface_normal = surface_normal;
+              const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+              r.n_untangle_moves += ts.moves;
+              say("untangling (Escobar objective): inverted tetrahedra " + std::to_string(ts.inverted_before) +
+                  " -> " + std::to_string(ts.inverted_after) + " (" + std::to_string(ts.sweeps) +
+                  " sweeps), folded interface triangles " + std::to_string(ts.folded_before) + " -> " +
+                  std::to_string(ts.folded_after));
+              bad2 = inverted_elements(fe.mesh);
+              folded2 = folded_faces(fe.mesh, fe.where, s);
+              if (bad2.empty() && folded2.empty()) before_escobar = std::move(old_problems);
+            }
+            for (std::size_t e : bad2) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
+            for (std::size_t f : folded2) problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
             break;
           }
           continue;
@@ -366,6 +395,13 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});
       for (std::size_t f : folded_faces(fe.mesh, fe.where, s))
         problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds after smoothing"});
+      if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
+        // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
+        // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
+        // what the max-min untangling alone would have done, refine around its problems.
+        say("untangling (Escobar objective): the mesh does not conform; refining instead");
+        problems = std::move(*before_escobar);
+      }
     }
     if (problems.empty() && topology_refinements < opt.topology_refinements && !last) {
       // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the

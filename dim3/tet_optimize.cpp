@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/LU>
+
 #include "core/error.hpp"
 
 namespace febemesh::dim3 {
@@ -109,6 +111,104 @@ struct Optimizer {
     }
     return g;
   }
+  /// Escobar et al.'s untangling objective of tetrahedron t with v at x: |S|^2 / (3 h(s)^(2/3)),
+  /// S its Jacobian against the regular tetrahedron of edge `scale`, s = det S and
+  /// h(s) = (s + sqrt(s^2 + 4 delta^2)) / 2 > 0, so that the sum over a node's tetrahedra is
+  /// finite and smooth across inverted ones, and its minimum lies where they are positive.
+  double escobar_at(std::int32_t t, std::int32_t v, const P3& x, double scale, double delta) const {
+    std::array<P3, 4> p;
+    for (int k = 0; k < 4; ++k) p[k] = tets[t][k] == v ? x : mesh.points[tets[t][k]];
+    // Inverse of the regular tetrahedron's edge matrix (columns (1,0,0), (1/2, sqrt3/2, 0),
+    // (1/2, sqrt3/6, sqrt(2/3))).
+    static const Eigen::Matrix3d w_inv = [] {
+      Eigen::Matrix3d w;
+      w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
+      return Eigen::Matrix3d(w.inverse());
+    }();
+    Eigen::Matrix3d a;
+    a.col(0) = (p[1] - p[0]) / scale;
+    a.col(1) = (p[2] - p[0]) / scale;
+    a.col(2) = (p[3] - p[0]) / scale;
+    const Eigen::Matrix3d sm = a * w_inv;
+    const double sigma = sm.determinant();
+    const double hs = 0.5 * (sigma + std::sqrt(sigma * sigma + 4.0 * delta * delta));
+    return sm.squaredNorm() / (3.0 * std::cbrt(hs * hs));
+  }
+  double escobar_sum(std::int32_t v, const P3& x, double scale, double delta) const {
+    double k = 0.0;
+    for (std::int32_t i = start[v]; i < start[v + 1]; ++i) k += escobar_at(incident[i], v, x, scale, delta);
+    return k;
+  }
+  int n_inverted_at(std::int32_t v, const P3& x) const {
+    int n = 0;
+    for (std::int32_t i = start[v]; i < start[v + 1]; ++i) n += quality_at(incident[i], v, x) < 0 ? 1 : 0;
+    return n;
+  }
+  int n_folded_at(std::int32_t v, const P3& x, const P3& nx) const {
+    int n = 0;
+    if (f_start.empty()) return 0;
+    for (std::int32_t k = f_start[v]; k < f_start[v + 1]; ++k) n += face_quality(f_incident[k], v, x, nx) < 0 ? 1 : 0;
+    return n;
+  }
+
+  /// Untangling by descent of the Escobar objective from x0 (projected onto the surface for
+  /// surface nodes). Max-min steps stall where no single direction raises the worst
+  /// tetrahedron; the smooth sum still has a descent direction there. The result is taken when
+  /// it inverts no more tetrahedra (and folds no more interface triangles) and lowers the sum.
+  bool escobar_descent(std::int32_t v, const P3& x0, double len, P3& x_out, BoundaryLocation& w_out) const {
+    const double scale = len;
+    double sigma_min = std::numeric_limits<double>::infinity();
+    for (std::int32_t i = start[v]; i < start[v + 1]; ++i) {
+      std::array<P3, 4> p;
+      for (int k = 0; k < 4; ++k) p[k] = mesh.points[tets[incident[i]][k]];
+      const double v6 = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / (scale * scale * scale);
+      sigma_min = std::min(sigma_min, v6 * std::sqrt(2.0));  // det S = 6 V sqrt2 / scale^3
+    }
+    const double eps = 1e-3;
+    const double delta = sigma_min < eps ? std::sqrt(eps * (eps - sigma_min)) : 0.0;
+    const bool surf = is_surface(v);
+    const bool guard = surf && !f_start.empty();
+    const int inv0 = n_inverted_at(v, x0);
+    const int fold0 = guard ? n_folded_at(v, x0, node_normal[v]) : 0;
+    P3 x = x0;
+    BoundaryLocation w = surf ? where[v] : BoundaryLocation{};
+    double k = escobar_sum(v, x, scale, delta);
+    const double k0 = k;
+    const double hd = 1e-5 * len;
+    for (int it = 0; it < 8; ++it) {
+      P3 g;
+      for (int d = 0; d < 3; ++d) {
+        P3 xp = x, xm = x;
+        xp[d] += hd;
+        xm[d] -= hd;
+        g[d] = (escobar_sum(v, xp, scale, delta) - escobar_sum(v, xm, scale, delta)) / (2 * hd);
+      }
+      if (surf) {
+        const P3 n = node_normal.empty() ? P3::Zero() : P3(node_normal[v]);
+        if (n.norm() > 0) g -= g.dot(n.normalized()) * n.normalized();
+      }
+      if (!(g.norm() > 0)) break;
+      const P3 dir = -g.normalized();
+      bool stepped = false;
+      for (double step = 0.5 * len; step >= 1e-3 * len; step *= 0.5) {
+        P3 y = x + step * dir;
+        BoundaryLocation wy;
+        if (surf) std::tie(y, wy) = opt.project(y);
+        const double ky = escobar_sum(v, y, scale, delta);
+        if (ky < k) {
+          x = y, w = wy, k = ky, stepped = true;
+          break;
+        }
+      }
+      if (!stepped) break;
+    }
+    if (!(k < k0 * (1.0 - 1e-9))) return false;
+    if (n_inverted_at(v, x) > inv0) return false;
+    if (guard && n_folded_at(v, x, opt.surface_normal(w)) > fold0) return false;
+    x_out = x;
+    w_out = w;
+    return true;
+  }
   bool is_surface(std::int32_t v) const {
     return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0;
   }
@@ -166,6 +266,14 @@ struct Optimizer {
       double f = worst_above(v, x, best + 1e-12);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w;
+    }
+    if (opt.untangle_only && opt.escobar && !(best > 0) && (!surf || opt.escobar_surface)) {
+      // The max-min candidates did not untangle this node's tetrahedra: descend the smooth
+      // objective instead (from the better of x0 and their best point).
+      P3 ex;
+      BoundaryLocation ew;
+      const P3 from = best_x;
+      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) best_x = ex, best_w = ew;
     }
     if (best_x == x0) return false;
     mesh.points[v] = best_x;

@@ -35,6 +35,12 @@ struct TetOptimizeOptions {
   SurfaceProjection project;
   /// Only untangle: stop a node as soon as its tetrahedra are all positive.
   bool untangle_only = false;
+  /// With untangle_only: where the max-min candidates leave a node's tetrahedra inverted,
+  /// descend Escobar et al.'s smooth untangling objective (a move that inverts no more
+  /// tetrahedra and lowers it is taken even if it does not raise the worst one). Surface nodes
+  /// too with escobar_surface (their descent is projected onto the surface).
+  bool escobar = false;
+  bool escobar_surface = false;
   /// Outward unit normal of the surface at a location. With it, the interface triangles of a
   /// surface node count among its elements: one whose normal points against the surface's
   /// (the sum at its three nodes) is folded, ranked like an inverted tetrahedron. Positive
