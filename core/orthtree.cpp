@@ -18,7 +18,8 @@ void* allocate_leaf_bytes(std::size_t bytes) {
   if (bytes >= (std::size_t(4) << 20)) advise_huge_pages(p, bytes);
   return p;
 }
-void deallocate_leaf_bytes(void* p, std::size_t bytes) noexcept { ::operator delete(p, bytes); }
+// Unsized: clang 14 has no sized operator delete without -fsized-deallocation.
+void deallocate_leaf_bytes(void* p, std::size_t /*bytes*/) noexcept { ::operator delete(p); }
 }  // namespace detail
 
 template <int Dim> Box<Dim> root_cube(const Box<Dim>& domain) {
