@@ -187,7 +187,7 @@ TEMPLATE_TEST_CASE_SIG("parallel balance equals serial", "[orthtree][balance]", 
   // into many subtrees at a split level below the root.
   const double r = 0.35;
   const int k = Dim == 2 ? 12 : 7;
-  const ControlFn<Dim> control = [r, k](const Box<Dim>& b) {
+  const ControlFn<Dim> control = [=](const Box<Dim>& b) {  // [=]: clang warns on an explicit capture of the constant k
     const Point<Dim> c = Point<Dim>::Constant(0.5);
     const double near = (c.cwiseMax(b.lo).cwiseMin(b.hi) - c).norm();
     Point<Dim> far;
