@@ -232,7 +232,7 @@ struct Projector {
     const double len = d.norm();
     if (len <= 0) return true;
     const P3 np = patch >= 0 ? P3(surface.surface().normal(patch).normalized()) : P3(P3::Zero());
-    for (int f = 0; f < 6; ++f) {
+    for (int f = 0; f < Cube<3>::n_faces; ++f) {
       if (!((dirs >> f) & 1)) continue;
       const double sign = (f % 2) ? 1.0 : -1.0;
       if (sign * d[f / 2] / len < min_outward) continue;

@@ -195,6 +195,35 @@ std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe
   return fixed;
 }
 
+/// One untangling pass (tet_optimize with untangle_only): the max-min node moves, or with
+/// `escobar` the smooth last resort. Surface nodes stay on the surface, corners stay put.
+TetOptimizeStats untangle_pass(TetMesh& fe, const OctantComplex& oc, int sweeps, bool escobar,
+                               const SurfaceProjection& project,
+                               const std::function<P3(const BoundaryLocation&)>& normal) {
+  TetOptimizeOptions to;
+  to.untangle_only = true;
+  to.escobar = escobar;
+  to.max_sweeps = sweeps;
+  to.fixed = fixed_nodes(oc, fe, false);
+  to.project = project;
+  to.surface_normal = normal;
+  return optimize_tets(fe.mesh, fe.where, to);
+}
+
+std::string untangle_summary(const std::string& pass, const TetOptimizeStats& ts) {
+  return pass + ": inverted tetrahedra " + std::to_string(ts.inverted_before) + " -> " +
+         std::to_string(ts.inverted_after) + " (" + std::to_string(ts.sweeps) + " sweeps), folded interface triangles " +
+         std::to_string(ts.folded_before) + " -> " + std::to_string(ts.folded_after);
+}
+
+/// Appends a problem at each inverted element and folded interface triangle, their messages
+/// followed by `when`.
+void add_problems(const Mesh<3>& m, const std::vector<std::size_t>& bad, const std::vector<std::size_t>& folded,
+                  const std::string& when, std::vector<Problem3>& out) {
+  for (std::size_t e : bad) out.push_back({centroid(m, e), "an element is inverted" + when});
+  for (std::size_t f : folded) out.push_back({face_centroid(m, f), "the surface mesh folds" + when});
+}
+
 }  // namespace
 
 namespace {
@@ -299,18 +328,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         {
           // Untangle by moving nodes (interior ones freely, surface ones on the surface,
           // corners not at all) before giving up snaps or refining.
-          TetOptimizeOptions to;
-          to.untangle_only = true;
-          to.max_sweeps = opt.untangle_sweeps;
-          to.fixed = fixed_nodes(oc.complex, fe, false);
-          to.project = surface_point;
-          to.surface_normal = surface_normal;
-          const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+          const TetOptimizeStats ts =
+              untangle_pass(fe, oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal);
           r.n_untangle_moves += ts.moves;
-          say("untangling: inverted tetrahedra " + std::to_string(ts.inverted_before) + " -> " +
-              std::to_string(ts.inverted_after) + " (" + std::to_string(ts.sweeps) +
-              " sweeps), folded interface triangles " + std::to_string(ts.folded_before) + " -> " +
-              std::to_string(ts.folded_after));
+          say(untangle_summary("untangling", ts));
         }
         const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
         const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s);
@@ -335,27 +356,16 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
             std::vector<std::size_t> bad2 = bad, folded2 = folded;
             if (opt.escobar_sweeps > 0) {
               std::vector<Problem3> old_problems;
-              for (std::size_t e : bad) old_problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
-              for (std::size_t f : folded) old_problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
-              TetOptimizeOptions to;
-              to.untangle_only = true;
-              to.escobar = true;
-              to.max_sweeps = opt.escobar_sweeps;
-              to.fixed = fixed_nodes(oc.complex, fe, false);
-              to.project = surface_point;
-              to.surface_normal = surface_normal;
-              const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+              add_problems(fe.mesh, bad, folded, "", old_problems);
+              const TetOptimizeStats ts =
+                  untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal);
               r.n_untangle_moves += ts.moves;
-              say("untangling (Escobar objective): inverted tetrahedra " + std::to_string(ts.inverted_before) +
-                  " -> " + std::to_string(ts.inverted_after) + " (" + std::to_string(ts.sweeps) +
-                  " sweeps), folded interface triangles " + std::to_string(ts.folded_before) + " -> " +
-                  std::to_string(ts.folded_after));
+              say(untangle_summary("untangling (Escobar objective)", ts));
               bad2 = inverted_elements(fe.mesh);
               folded2 = folded_faces(fe.mesh, fe.where, s);
               if (bad2.empty() && folded2.empty()) before_escobar = std::move(old_problems);
             }
-            for (std::size_t e : bad2) problems.push_back({centroid(fe.mesh, e), "an element is inverted"});
-            for (std::size_t f : folded2) problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds"});
+            add_problems(fe.mesh, bad2, folded2, "", problems);
             break;
           }
           continue;
@@ -391,10 +401,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         r.n_optimize_moves = ts.moves;
       }
       clock.lap("smoothing");
-      for (std::size_t e : inverted_elements(fe.mesh))
-        problems.push_back({centroid(fe.mesh, e), "an element is inverted after smoothing"});
-      for (std::size_t f : folded_faces(fe.mesh, fe.where, s))
-        problems.push_back({face_centroid(fe.mesh, f), "the surface mesh folds after smoothing"});
+      add_problems(fe.mesh, inverted_elements(fe.mesh), folded_faces(fe.mesh, fe.where, s), " after smoothing", problems);
       if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
