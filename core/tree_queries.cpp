@@ -118,14 +118,19 @@ std::size_t covering_leaf_near(const Orthtree<Dim>& t, const Keys& keys, const C
   return it - 1;
 }
 
-template <int Dim, class Keys> std::size_t leaf_at(const Orthtree<Dim>& t, const Keys& keys, const LatticePoint<Dim>& p) {
+/// The finest-level cell anchored at p; false when p lies outside the root.
+template <int Dim> bool unit_cell_at(const LatticePoint<Dim>& p, Cell<Dim>& unit) {
   for (int d = 0; d < Dim; ++d) {
-    if (p[d] >= root_length<Dim>) return no_leaf;
+    if (p[d] >= root_length<Dim>) return false;
   }
-  Cell<Dim> unit;
   unit.anchor = p;
   unit.level = std::uint8_t(max_level<Dim>);
-  return covering_leaf(t, keys, unit);
+  return true;
+}
+
+template <int Dim, class Keys> std::size_t leaf_at(const Orthtree<Dim>& t, const Keys& keys, const LatticePoint<Dim>& p) {
+  Cell<Dim> unit;
+  return unit_cell_at(p, unit) ? covering_leaf(t, keys, unit) : no_leaf;
 }
 
 /// Leaves inside cell c that touch its facet on side `side` of `axis`, depth first in Morton order.
@@ -228,13 +233,8 @@ template <int Dim> std::size_t LeafKeys<Dim>::locate(const LatticePoint<Dim>& p)
 }
 
 template <int Dim> std::size_t LeafKeys<Dim>::locate_near(const LatticePoint<Dim>& p, std::size_t hint) const {
-  for (int d = 0; d < Dim; ++d) {
-    if (p[d] >= root_length<Dim>) return no_leaf;
-  }
   Cell<Dim> unit;
-  unit.anchor = p;
-  unit.level = std::uint8_t(max_level<Dim>);
-  return covering_leaf_near(*tree_, FlatKeys{keys_}, unit, hint);
+  return unit_cell_at(p, unit) ? covering_leaf_near(*tree_, FlatKeys{keys_}, unit, hint) : no_leaf;
 }
 
 template <int Dim> void LeafKeys<Dim>::face_neighbours(std::size_t i, int f, std::vector<std::size_t>& out) const {
