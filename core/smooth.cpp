@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/guard_order.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
 
@@ -112,7 +113,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       bool accept = true;
       after.resize(elems.size());
       for (std::size_t j = 0; j < elems.size() && accept; ++j) {
-        const std::size_t k = j == 0 ? worst : (j <= worst ? j - 1 : j);
+        const std::size_t k = worst_first(j, worst);
         after[k] = element_state(elems[k]);
         accept = (after[k].first || !state[elems[k]].first) && after[k].second >= old_min;
       }

@@ -7,6 +7,7 @@
 #include <span>
 
 #include "core/error.hpp"
+#include "core/guard_order.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -263,7 +264,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         // that held old_q is the likeliest to fail, so it goes first.
         bool better = true;
         for (std::size_t j = 0; j < elems.size() && better; ++j) {
-          const std::size_t k = j == 0 ? worst : (j <= worst ? j - 1 : j);
+          const std::size_t k = worst_first(j, worst);
           trial[k] = min_corner_angle_deg(m, static_cast<std::size_t>(elems[k]));
           better = trial[k] > old_q + 1e-12;
         }
