@@ -471,15 +471,31 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     }
 
     // Boundary nodes: one per distinct parameter along the chain (equal ones are shared).
+    // A node shared by a corner and a plain projection (a projection merged into the corner, or
+    // made first at the same point) is the corner: marked so that no later pass slides it off.
+    auto corner_location = [&](std::int32_t ci) {
+      BoundaryLocation w;
+      w.patch = loop;
+      w.param[0] = curve.corners()[ci].t;
+      w.kind = BoundaryLocation::Kind::Corner;
+      w.feature = ci;
+      return w;
+    };
     std::vector<std::int32_t> pnode(m, -1);
     for (std::size_t k = 0; k < m; ++k) {
       if (v[k] != u[k] && corner_at[k] < 0) ++res.stats.n_clamped;
+      auto share = [&](std::int32_t node) {
+        pnode[k] = node;
+        if (corner_at[k] < 0) return;
+        qc.points[node] = curve.corners()[corner_at[k]].point;
+        qc.where[node] = corner_location(corner_at[k]);
+      };
       if (k > 0 && v[k] == v[k - 1]) {
-        pnode[k] = pnode[k - 1];
+        share(pnode[k - 1]);
         continue;
       }
       if (k > 0 && v[k] == v[0] + n) {  // closes onto the chain's first boundary node
-        pnode[k] = pnode[0];
+        share(pnode[0]);
         continue;
       }
       BoundaryLocation w;
@@ -487,11 +503,8 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       w.param[0] = wrap(v[k], n);
       Point<2> p;
       if (corner_at[k] >= 0) {
-        const auto& c = curve.corners()[corner_at[k]];
-        p = c.point;
-        w.param[0] = c.t;
-        w.kind = BoundaryLocation::Kind::Corner;
-        w.feature = corner_at[k];
+        p = curve.corners()[corner_at[k]].point;
+        w = corner_location(corner_at[k]);
       } else if (v[k] == u[k]) {
         p = cp[k].point;
         w = cp[k].where;
@@ -504,11 +517,11 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       // Projections that land on the same point (e.g. both sides of a corner) share a node.
       const double eps = 1e-6 * h[k];
       if (k > 0 && (qc.points[pnode[k - 1]] - p).norm() <= eps) {
-        pnode[k] = pnode[k - 1];
+        share(pnode[k - 1]);
         continue;
       }
       if (k > 0 && k + 1 == m && (qc.points[pnode[0]] - p).norm() <= eps) {
-        pnode[k] = pnode[0];
+        share(pnode[0]);
         continue;
       }
       pnode[k] = qc.add_node(p, NodeKind::Boundary, w);
@@ -519,12 +532,13 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       const FreeFacet<2>& f = facets[ch.facet[k]];
       BoundaryQuadrant b;
       b.node = {ch.q[kn], ch.q[k], pnode[k], pnode[kn]};
-      if (corner_after[k] >= 0 &&
-          (qc.points[pnode[k]] - curve.corners()[corner_after[k]].point).norm() <= 1e-9 * h[k]) {
-        corner_after[k] = -1;  // the projection is the corner already
-      }
-      if (corner_after[k] >= 0 &&
-          (qc.points[pnode[kn]] - curve.corners()[corner_after[k]].point).norm() <= 1e-9 * h[k]) {
+      // A projection that is the corner already is the corner node (marked as one).
+      for (const std::size_t j : {k, kn}) {
+        if (corner_after[k] < 0) break;
+        const Point<2>& c = curve.corners()[corner_after[k]].point;
+        if ((qc.points[pnode[j]] - c).norm() > 1e-9 * h[k]) continue;
+        qc.points[pnode[j]] = c;
+        qc.where[pnode[j]] = corner_location(corner_after[k]);
         corner_after[k] = -1;
       }
       if (corner_after[k] >= 0) {

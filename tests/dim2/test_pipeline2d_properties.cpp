@@ -63,6 +63,8 @@ void check_valid(const test::PipelineOutcome& out) {
   // FE area == BE polygon area to round-off: a sum of n_solid areas, each exact to a few ulps.
   const double round_off = 4.0 * std::numeric_limits<double>::epsilon() * double(out.v.n_solid);
   RC_ASSERT(std::abs(out.f.fe_area - out.f.be_polygon_area) <= round_off * out.f.exact_area);
+  // Every corner of the curve is an interface node, unless the last repair reported it missed.
+  RC_ASSERT(out.corners_off_mesh == out.r.stats.n_corners_missed);
   // Quality bound. The paper's templates promise none after smoothing and corner pulling; what
   // holds, measured over ~1000 random cases at levels 6-8 (issue 5 note): min angle >= 4.3 deg
   // (tri), 6.7 (mixed), asserted with a margin. Quad (split after the quality pass, then the

@@ -81,6 +81,8 @@ void check_combo(const Combo& c) {
     const double round_off = 4.0 * std::numeric_limits<double>::epsilon() * double(out.v.n_solid);
     CHECK(std::abs(out.f.fe_area - out.f.be_polygon_area) <= round_off * out.f.exact_area);
     CHECK(out.q.min_scaled_jacobian > 0.0);
+    // Every corner of the curve is an interface node, unless the last repair reported it missed.
+    CHECK(out.corners_off_mesh == out.r.stats.n_corners_missed);
     CurveBoundary bare(read_domain(full_path(c.file)));
     const AnglesAwayFromCorners tri = angles_away_from_sharp_corners(out.r.fe.mesh, bare, 20.0);
     const AnglesAwayFromCorners quad = angles_away_from_sharp_corners(out.r.fe.mesh, bare, 30.0);
