@@ -72,6 +72,26 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
   }
 
+  // The two BE chord neighbours of each interface node (-1: none), for the chord bound.
+  std::vector<std::array<std::int32_t, 2>> chord_nbr;
+  if (opt.curve_distance) {
+    chord_nbr.assign(n_nodes, {-1, -1});
+    for (std::size_t s = 0; s < m.interface.size(); ++s) {
+      const VertexId* ab = m.interface.nodes(ElemId{static_cast<std::int32_t>(s)});
+      for (int j = 0; j < 2; ++j) {
+        auto& slot = chord_nbr[ab[j].v];
+        (slot[0] < 0 ? slot[0] : slot[1]) = ab[1 - j].v;
+      }
+    }
+  }
+  // How far v's two chords stray from the curve with v at p (their midpoints' distance).
+  auto chord_deviation = [&](std::size_t v, const P2& p) {
+    double d = 0.0;
+    for (const std::int32_t u : chord_nbr[v])
+      if (u >= 0) d = std::max(d, opt.curve_distance(0.5 * (p + m.points[u])));
+    return d;
+  };
+
   // Worst q around v, or any value <= floor once it is known to be <= floor (the caller only
   // asks whether it beats floor).
   auto local_worst = [&](std::size_t v, double floor) {
@@ -123,6 +143,8 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       const P2 start = m.points[v];
       // A candidate as the node would really sit there (on the curve for sliding nodes).
       auto place = [&](const P2& p) { return lock == 2 ? slide(static_cast<std::int32_t>(v), p) : p; };
+      const bool bound_chords = lock == 2 && !chord_nbr.empty();
+      const double chord_limit = bound_chords ? chord_deviation(v, start) : 0.0;
       P2 best = start, centroid = P2::Zero();
       double h = 0.0;
       for (std::int32_t k = nbr_first[v]; k < nbr_first[v + 1]; ++k) {
@@ -137,6 +159,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
         if (p == best) return false;
         const double q = worst_at(v, p, best_q);
         if (q <= best_q) return false;
+        if (bound_chords && chord_deviation(v, p) > chord_limit) return false;
         best_q = q;
         best = p;
         return true;

@@ -12,6 +12,7 @@
 // ever inverts (an inverted or reflex corner gives q < 0, which is never accepted).
 // Deterministic: nodes are visited in index order, candidates in a fixed order.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -26,6 +27,10 @@ double angle_quality(const Mesh<2>& m, std::size_t e);
 struct AngleOptimiseOptions {
   int rounds = 8;         ///< sweeps over the nodes
   double target = 1.25;   ///< nodes whose elements all reach this q are left alone
+  /// Distance from a point to the curve. When set, a sliding interface node may move only where
+  /// its two BE chords stay as close to the curve as they were (the larger of the two chord
+  /// midpoints' distances does not grow), so raising angles never costs boundary fidelity.
+  std::function<double(const Point<2>&)> curve_distance;
 };
 
 struct AngleOptimiseStats {

@@ -161,6 +161,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
         AngleOptimiseOptions ao;
         ao.rounds = 2 * opt.improve_rounds;
         ao.target = opt.elements == ElementKind::Tri ? 1.5 : 1.25;
+        ao.curve_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
         r.n_angle_moves = optimise_angles(fe.mesh, locked, ao, slide).moves;
         settle_interface();
         clock.lap("angle optimisation");

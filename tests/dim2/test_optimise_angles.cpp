@@ -86,46 +86,86 @@ TEST_CASE("a badly placed interior node is moved until every quad is within [30,
     if (locked[v]) CHECK(m.points[v] == before.points[v]);
 }
 
-TEST_CASE("sliding nodes stay on the curve", "[optimise_angles]") {
-  // A ring of quads between radii 1 and 2; outer nodes slide on the circle of radius 2 and start
-  // bunched up, so spreading them along the circle is what improves the quads.
-  const int k = 16;
+namespace {
+
+/// A ring of k quads between radii 1 and 2, counter-clockwise, the inner nodes (even indices)
+/// evenly spaced and the outer ones (odd) out of step by `outer_shift` x half the spacing,
+/// alternately forwards and backwards (or the other way round). The outer circle's chords are
+/// the interface (Line2) elements.
+Mesh<2> ring(int k, double inner_shift, double outer_shift) {
   Mesh<2> m;
   for (int i = 0; i < k; ++i) {
-    const double a = 2 * M_PI * i / k;
-    const double b = a + (i % 2 ? 0.6 : -0.6) * (M_PI / k);  // outer nodes out of step
+    const double a = 2 * M_PI * i / k + (i % 2 ? inner_shift : -inner_shift) * (M_PI / k);
+    const double b = 2 * M_PI * i / k + (i % 2 ? outer_shift : -outer_shift) * (M_PI / k);
     m.add_point(Point<2>(std::cos(a), std::sin(a)));
     m.add_point(Point<2>(2 * std::cos(b), 2 * std::sin(b)));
   }
   for (int i = 0; i < k; ++i) {
     const int j = (i + 1) % k;
     m.solid.add(ElemType::Quad4, {VertexId{2 * i}, VertexId{2 * i + 1}, VertexId{2 * j + 1}, VertexId{2 * j}});
+    m.interface.add(ElemType::Line2, {VertexId{2 * j + 1}, VertexId{2 * i + 1}});
     m.level.push_back(0);
     m.from_boundary_cell.push_back(0);
   }
-  // The ring runs clockwise this way round: reverse to CCW if needed.
-  if (angle_quality(m, 0) < 0) {
-    Mesh<2> r;
-    r.points = m.points;
-    for (int i = 0; i < k; ++i) {
-      const int j = (i + 1) % k;
-      r.solid.add(ElemType::Quad4, {VertexId{2 * i}, VertexId{2 * j}, VertexId{2 * j + 1}, VertexId{2 * i + 1}});
-      r.level.push_back(0);
-      r.from_boundary_cell.push_back(0);
-    }
-    m = r;
-  }
-  REQUIRE(worst(m) > 0);
+  return m;
+}
+
+/// Outer nodes bunched in pairs: spreading them along the circle improves the quads.
+Mesh<2> bunched_ring(int k) { return ring(k, 0.0, 0.6); }
+
+std::vector<std::uint8_t> outer_slides(const Mesh<2>& m) {
   std::vector<std::uint8_t> locked(m.points.size());
   for (std::size_t v = 0; v < locked.size(); ++v) locked[v] = v % 2 ? 2 : 1;
-  const SlideFn on_circle = [](std::int32_t, const Point<2>& p) { return Point<2>(2.0 * p.normalized()); };
+  return locked;
+}
+
+const SlideFn on_circle = [](std::int32_t, const Point<2>& p) { return Point<2>(2.0 * p.normalized()); };
+
+/// Largest distance from the outer circle to the midpoint of an interface chord.
+double worst_chord_deviation(const Mesh<2>& m) {
+  double d = 0.0;
+  for (std::size_t s = 0; s < m.interface.size(); ++s) {
+    const VertexId* ab = m.interface.nodes(ElemId{static_cast<std::int32_t>(s)});
+    d = std::max(d, 2.0 - (0.5 * (m.points[ab[0].v] + m.points[ab[1].v])).norm());
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("sliding nodes stay on the curve", "[optimise_angles]") {
+  Mesh<2> m = bunched_ring(16);
+  REQUIRE(worst(m) > 0);
   const double q0 = worst(m);
   AngleOptimiseOptions ao;
   ao.target = 3.0;  // above the start (about 2.2): optimise every node
-  optimise_angles(m, locked, ao, on_circle);
+  optimise_angles(m, outer_slides(m), ao, on_circle);
   CHECK(worst(m) > q0);
   for (std::size_t v = 1; v < m.points.size(); v += 2) CHECK(std::abs(m.points[v].norm() - 2.0) < 1e-12);
   for (std::size_t v = 0; v < m.points.size(); v += 2) CHECK(std::abs(m.points[v].norm() - 1.0) < 1e-12);
+}
+
+TEST_CASE("with curve_distance, sliding never takes a chord farther from the curve", "[optimise_angles]") {
+  // Inner nodes bunched, outer nodes even: the quads improve when the outer nodes follow the
+  // inner ones, which lengthens every other chord. Unbounded, the optimiser does that; with the
+  // bound (every chord is already the longest) the chords keep their distance to the circle.
+  AngleOptimiseOptions ao;
+  ao.target = 3.0;
+  for (const int k : {8, 16, 24}) {
+    Mesh<2> bounded = ring(k, 0.5, 0.0), unbounded = bounded;
+    const double d0 = worst_chord_deviation(bounded), q0 = worst(bounded);
+    REQUIRE(q0 > 0);
+    optimise_angles(unbounded, outer_slides(unbounded), ao, on_circle);
+    AngleOptimiseOptions bounded_ao = ao;
+    bounded_ao.curve_distance = [](const Point<2>& p) { return std::abs(2.0 - p.norm()); };
+    optimise_angles(bounded, outer_slides(bounded), bounded_ao, on_circle);
+    INFO("k = " << k << ", chord deviation " << d0 << " -> " << worst_chord_deviation(bounded)
+                << " (unbounded " << worst_chord_deviation(unbounded) << ")");
+    CHECK(worst_chord_deviation(unbounded) > 1.05 * d0);  // the bound is what holds it
+    CHECK(worst_chord_deviation(bounded) <= d0);
+    CHECK(worst(bounded) >= q0);
+    for (std::size_t v = 1; v < bounded.points.size(); v += 2) CHECK(std::abs(bounded.points[v].norm() - 2.0) < 1e-12);
+  }
 }
 
 TEST_CASE("the optimiser never inverts an element nor lowers the worst quality", "[optimise_angles][property]") {
