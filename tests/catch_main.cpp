@@ -1,5 +1,5 @@
 // Test main: FEBEMESH_PROPERTY_CASES=N runs every rapidcheck property N times (default: each
-// property's own CI budget). RC_PARAMS, when set, wins (e.g. RC_PARAMS="seed=123" to replay).
+// property's own CI budget), also next to RC_PARAMS="seed=S"; a max_success in RC_PARAMS wins.
 #define CATCH_CONFIG_RUNNER
 #include <catch2/catch.hpp>
 
@@ -8,9 +8,13 @@
 
 int main(int argc, char* argv[]) {
   const char* cases = std::getenv("FEBEMESH_PROPERTY_CASES");
-  if (cases != nullptr && std::getenv("RC_PARAMS") == nullptr) {
-    const std::string params = "max_success=" + std::string(cases);
-    setenv("RC_PARAMS", params.c_str(), 1);
+  if (cases != nullptr) {
+    const char* given = std::getenv("RC_PARAMS");
+    std::string params = given != nullptr ? given : "";
+    if (params.find("max_success") == std::string::npos) {
+      params += (params.empty() ? "" : " ") + std::string("max_success=") + cases;
+      setenv("RC_PARAMS", params.c_str(), 1);
+    }
   }
   return Catch::Session().run(argc, argv);
 }
