@@ -558,11 +558,11 @@ void CurveBoundary::compute_automatic_levels() {
   auto level_for = [&](double h) { return h > 0.0 ? std::max(0.0, std::ceil(std::log2(root / h))) : 0.0; };
   const bool automatic = !(has_curve_levels_ || !domain_.interior.empty() || domain_.default_level != no_level);
   if (automatic) auto_level_.resize(domain_.loops.size());
-  thickness_level_.resize(domain_.loops.size());
+  floor_level_.resize(domain_.loops.size());
   for (std::size_t i = 0; i < domain_.loops.size(); ++i) {
     const Loop& l = domain_.loops[i];
     if (automatic) auto_level_[i].assign(l.n_pieces(), 0.0);
-    thickness_level_[i].assign(l.n_pieces(), 0.0);
+    floor_level_[i].assign(l.n_pieces(), 0.0);
     for (std::size_t k = 0; k < l.n_pieces(); ++k) {
       const Bezier& q = l.pieces[k];
       double thick_lv = 0.0, feature_lv = 0.0;
@@ -574,11 +574,11 @@ void CurveBoundary::compute_automatic_levels() {
         const double thick = local_thickness(s);
         if (std::isfinite(thick)) thick_lv = std::max(thick_lv, level_for(thick / quadrants_across_feature));
       }
-      thickness_level_[i][k] = feature_lv;
-      if (!automatic) continue;
       double kmax = 0.0;
       for (int j = 0; j <= 32; ++j) kmax = std::max(kmax, std::abs(bezier_curvature(q, j / 32.0)));
-      auto_level_[i][k] = std::max(thick_lv, kmax > 0.0 ? level_for(0.3 / kmax) : 0.0);
+      const double curvature_lv = kmax > 0.0 ? level_for(cells_per_radius / kmax) : 0.0;
+      floor_level_[i][k] = std::max(feature_lv, curvature_lv);
+      if (automatic) auto_level_[i][k] = std::max(thick_lv, curvature_lv);
     }
   }
 }
@@ -590,16 +590,16 @@ double CurveBoundary::control_level(const Box<2>& box) const {
   for (const InteriorControl& c : domain_.interior)
     if (box_distance2(box, c.p) <= c.radius * c.radius) lv = std::max(lv, c.level);
   const bool automatic = is_automatic();
-  // Features thinner than the quadrants are refined until resolved, even with given levels
-  // (at most thickness_boost levels above what was asked).
+  // Features thinner than the quadrants and bends tighter than them are refined until resolved,
+  // even with given levels (at most floor_boost levels above what was asked).
   const double given = lv;
   traverse([&](const Box<2>& b) { return b.overlaps(box); },
            [&](int r) {
              const Piece& pc = pieces_[std::size_t(r)];
              if (!automatic) {
-               const double thick = std::min(thickness_level_[std::size_t(pc.loop)][std::size_t(pc.index)],
-                                             std::min(double(max_level_), given + thickness_boost));
-               if (thick > lv && piece_meets_box(r, box)) lv = thick;
+               const double floor = std::min(floor_level_[std::size_t(pc.loop)][std::size_t(pc.index)],
+                                             std::min(double(max_level_), given + floor_boost));
+               if (floor > lv && piece_meets_box(r, box)) lv = floor;
              }
              if (automatic) {
                if (auto_level_[std::size_t(pc.loop)][std::size_t(pc.index)] > lv && piece_meets_box(r, box))

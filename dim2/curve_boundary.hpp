@@ -21,8 +21,9 @@
 //                          to another local minimum of the distance along the boundary, i.e.
 //                          across a thin part, a slot, or to a nearby loop or an acute corner),
 //     capped by max_level() (default 12). Cells away from the curve get level 0.
-//   - with given levels, the thickness rule still applies (features thinner than the quadrants
-//     are refined until resolved), at most 4 levels beyond the given level.
+//   - with given levels, the thickness rule (features thinner than the quadrants are refined
+//     until resolved) and the curvature rule h_L <= 0.3 R still apply, at most 4 levels beyond
+//     the given level.
 // Levels are relative to root_box(), the tree's root: the smallest square around
 // bounding_box() enlarged by 5%.
 
@@ -107,6 +108,10 @@ class CurveBoundary final : public Boundary<2> {
   /// and an arbitrary lattice offset, a straight stroke of width w holds an edge-connected row of
   /// interior quadrants of size s only when w >= 2.7 s, and a diagonal one when w >= ~3.5 s.
   static constexpr double quadrants_across_feature = 4.0;
+  /// Largest quadrant size along the curve, in radii of curvature: 0.3 keeps a chord's sagitta
+  /// below 1.2% of its length (h^2 / 8R), so a tight bend (an airfoil's leading edge) is never
+  /// cut by one chord of a coarse cell.
+  static constexpr double cells_per_radius = 0.3;
 
  private:
   struct Piece {
@@ -154,8 +159,10 @@ class CurveBoundary final : public Boundary<2> {
   std::vector<std::vector<int>> corner_of_;       ///< [loop][piece] -> corner index or -1
   std::vector<std::vector<int>> level_junctions_;  ///< per loop: junctions with a level, ascending
   std::vector<std::vector<double>> auto_level_;    ///< [loop][piece]
-  std::vector<std::vector<double>> thickness_level_;  ///< [loop][piece]: cells <= half the local thickness
-  static constexpr double thickness_boost = 4.0;     ///< thin features refine at most this far beyond a given level
+  /// [loop][piece]: the level the piece needs whatever was asked: cells no larger than a
+  /// quarter of the feature thickness nor cells_per_radius x the smallest radius of curvature.
+  std::vector<std::vector<double>> floor_level_;
+  static constexpr double floor_boost = 4.0;  ///< at most this far beyond a given level
   Box<2> bbox_;
   double scale_ = 1.0;  ///< largest extent of the bounding box
   double global_level_ = no_level;

@@ -93,7 +93,8 @@ TEST_CASE("mesh2d gives valid FE and BE meshes on the bundled examples", "[pipel
 }
 
 TEST_CASE("area error and Hausdorff distance fall with the level", "[pipeline2d]") {
-  // A smooth ellipse-like B-spline with no levels in the file, so --level alone sets h.
+  // A smooth ellipse-like B-spline with no levels in the file, so --level alone sets h (from
+  // level 5 on: below it the curvature floor, h <= 0.3 R at the tips, refines the ends).
   Domain d;
   d.source = "ellipse";
   std::vector<ControlPoint> cps;
@@ -103,7 +104,7 @@ TEST_CASE("area error and Hausdorff distance fall with the level", "[pipeline2d]
   }
   d.loops.push_back(loop_from_bspline(cps, "ellipse"));
   std::vector<double> area, haus;
-  for (double level : {4.0, 5.0, 6.0, 7.0}) {
+  for (double level : {5.0, 6.0, 7.0, 8.0}) {
     CurveBoundary curve(d);
     curve.set_global_level(level);
     Options2d opt;
@@ -124,6 +125,34 @@ TEST_CASE("area error and Hausdorff distance fall with the level", "[pipeline2d]
   // Chords of a smooth curve: second order. Three halvings of h: 64x in theory; require 16x.
   CHECK(haus.back() < haus.front() / 16.0);
   CHECK(area.back() < area.front() / 16.0);
+}
+
+TEST_CASE("a bend tighter than the quadrants is refined even with a given level", "[pipeline2d]") {
+  // A thin ellipse, semi-axes 2 and 0.25: radius of curvature b^2 / a = 0.031 at the tips, where
+  // a level-4 quadrant (root side 4.2 / 16 = 0.26) is 8 radii long. The curvature floor refines
+  // the tips to h <= 0.3 R; a chord there then strays at most ~h^2 / 4R = 0.0225 R.
+  Domain d;
+  d.source = "thin ellipse";
+  std::vector<ControlPoint> cps;
+  for (int k = 0; k < 24; ++k) {
+    const double a = 2.0 * M_PI * k / 24.0;
+    cps.push_back({Point<2>(2.0 * std::cos(a), 0.25 * std::sin(a)), false, no_level});
+  }
+  d.loops.push_back(loop_from_bspline(cps, "thin ellipse"));
+  CurveBoundary curve(d);
+  double r_min = 1e300;
+  for (std::size_t k = 0; k < curve.loops()[0].n_pieces(); ++k)
+    for (int j = 0; j <= 32; ++j) r_min = std::min(r_min, 1.0 / std::abs(curve.curvature(0, k + j / 32.0)));
+  REQUIRE(r_min < 0.05);
+  curve.set_global_level(4.0);
+  Options2d opt;
+  opt.level = 4.0;
+  opt.keep_stages = false;
+  const Result2d r = mesh2d(curve, opt);
+  REQUIRE(validate<2>(r.fe.mesh).valid);
+  const Fidelity2d f = measure_fidelity(r.fe, curve);
+  INFO("smallest radius " << r_min << ", Hausdorff " << f.hausdorff << " = " << f.hausdorff / r_min << " R");
+  CHECK(f.hausdorff < 0.05 * r_min);
 }
 
 TEST_CASE("mesh2d is deterministic", "[pipeline2d]") {
