@@ -362,6 +362,23 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         }
         const double t = 0.5 * (x0 + x1);
         v[k] = dist(t) <= best_d ? std::clamp(t, lo, hi) : best_t;
+        // At a step of the interior quadrants' staircase the segment to that point can lean
+        // under the step into an interior quadrant (the curve's normal tilted toward the finer
+        // side); then take the nearest point on [lo, hi] that Q reaches without entering one.
+        if (proj.admissible(q, curve.evaluate(loop, wrap(v[k], n)))) continue;
+        constexpr int fine = 256;
+        std::vector<std::pair<double, double>> by_distance;  // (squared distance, t)
+        for (int s = 0; s <= fine; ++s) {
+          const double ts = lo + (hi - lo) * s / fine;
+          by_distance.emplace_back(dist(ts), ts);
+        }
+        std::sort(by_distance.begin(), by_distance.end());
+        for (const auto& [d, ts] : by_distance)
+          if (proj.admissible(q, curve.evaluate(loop, wrap(ts, n)))) {
+            v[k] = ts;
+            ++res.stats.n_reachable_in_order;
+            break;
+          }
       }
     }
 

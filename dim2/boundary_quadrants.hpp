@@ -29,6 +29,7 @@ struct BoundaryQuadrantStats {
   std::size_t n_next_normal = 0;   ///< projections that took a further normal
   std::size_t n_walked = 0;        ///< projections found by walking along the curve
   std::size_t n_clamped = 0;       ///< projections clamped to keep the order along the curve
+  std::size_t n_reachable_in_order = 0;  ///< clamped ones moved off a point reached only through an interior quadrant
   std::size_t n_triangles = 0;     ///< boundary quadrants with P1 == P2
   std::size_t n_corners_pulled = 0;
   std::size_t n_corners_inserted = 0;  ///< corners added between two boundary nodes

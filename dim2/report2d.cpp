@@ -50,6 +50,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   bq["edge_flips"] = r.n_flips;
   bq["angle_optimisation_moves"] = r.n_angle_moves;
   bq["corners_missed"] = r.stats.n_corners_missed;
+  bq["clamped_moved_to_reachable"] = r.stats.n_reachable_in_order;
   bq["buffer_dropped"] = r.n_buffer_dropped;
   bq["pinches_dropped"] = r.n_pinches_dropped;
   bq["repairs"] = r.n_repairs;
