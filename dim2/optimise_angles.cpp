@@ -72,6 +72,14 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
   }
 
+  // Triangles measured against their own aim (q x target / triangle_target); 1 exactly when
+  // there is none, so that one-kind meshes see angle_quality itself.
+  const double triangle_scale = opt.triangle_target > 0 ? opt.target / opt.triangle_target : 1.0;
+  auto scaled_quality = [&](std::size_t e) {
+    const double q = angle_quality(m, e);
+    return m.solid.type[e] == ElemType::Tri3 && q > 0 ? q * triangle_scale : q;
+  };
+
   // The two BE chord neighbours of each interface node (-1: none), for the chord bound.
   std::vector<std::array<std::int32_t, 2>> chord_nbr;
   if (opt.curve_distance) {
@@ -96,13 +104,13 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // asks whether it beats floor).
   auto local_worst = [&](std::size_t v, double floor) {
     double q = 1e300;
-    for (std::int32_t k = first[v]; k < first[v + 1] && q > floor; ++k) q = std::min(q, angle_quality(m, incident[k]));
+    for (std::int32_t k = first[v]; k < first[v + 1] && q > floor; ++k) q = std::min(q, scaled_quality(incident[k]));
     return q;
   };
   // The q of every element, refreshed when one of its nodes moves: most nodes are already
   // above the target and are skipped on these cached values (the same numbers).
   std::vector<double> q_elem(n_elems);
-  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = angle_quality(m, e);
+  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = scaled_quality(e);
   // q_elem is refreshed wherever a node moves, so it is the mesh's q before and after.
   auto mesh_worst = [&] {
     double q = 1e300;
@@ -175,7 +183,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       }
       if (best != start) {
         m.points[v] = best;  // (the caller recomputes where sliding nodes lie on the curve)
-        for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q_elem[incident[k]] = angle_quality(m, incident[k]);
+        for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q_elem[incident[k]] = scaled_quality(incident[k]);
         ++st.moves;
         ++moved_this_round;
       }

@@ -27,6 +27,9 @@ double angle_quality(const Mesh<2>& m, std::size_t e);
 struct AngleOptimiseOptions {
   int rounds = 8;         ///< sweeps over the nodes
   double target = 1.25;   ///< nodes whose elements all reach this q are left alone
+  /// When > 0, triangles aim at this q instead (mixed meshes: 1.5, i.e. 30 deg, while quads
+  /// keep target); the search then raises the worst q relative to each element's aim.
+  double triangle_target = 0.0;
   /// Distance from a point to the curve. When set, a sliding interface node may move only where
   /// its two BE chords stay as close to the curve as they were (the larger of the two chord
   /// midpoints' distances does not grow), so raising angles never costs boundary fidelity.

@@ -168,6 +168,37 @@ TEST_CASE("with curve_distance, sliding never takes a chord farther from the cur
   }
 }
 
+TEST_CASE("triangle_target makes triangles of a mixed mesh aim higher than its quads", "[optimise_angles]") {
+  // Square [0, 2]^2, its side midpoints fixed, one free node X at (0.7, 1.3): three quads and
+  // the upper-right quarter as two triangles X F C, X C G. Smallest triangle angle 28.3 deg
+  // (q = 1.42), quads within [43.6, 136.4] (q >= 1.45): all above the quad aim 1.25.
+  Mesh<2> m;
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {0, 0}, {2, 0}, {2, 2}, {0, 2}, {1, 0}, {2, 1}, {1, 2}, {0, 1}, {0.7, 1.3}})
+    m.add_point(Point<2>(x, y));
+  enum { A, B, C, D, E, F, G, H, X };
+  m.solid.add(ElemType::Quad4, {VertexId{A}, VertexId{E}, VertexId{X}, VertexId{H}});
+  m.solid.add(ElemType::Quad4, {VertexId{E}, VertexId{B}, VertexId{F}, VertexId{X}});
+  m.solid.add(ElemType::Quad4, {VertexId{H}, VertexId{X}, VertexId{G}, VertexId{D}});
+  m.solid.add(ElemType::Tri3, {VertexId{X}, VertexId{F}, VertexId{C}});
+  m.solid.add(ElemType::Tri3, {VertexId{X}, VertexId{C}, VertexId{G}});
+  std::vector<std::uint8_t> locked(m.points.size(), 1);
+  locked[X] = 0;
+  REQUIRE(angle_quality(m, 4) * 20.0 == Approx(28.3).margin(0.1));
+
+  AngleOptimiseOptions ao;  // target 1.25 for every element: nothing to do
+  Mesh<2> same = m;
+  CHECK(optimise_angles(same, locked, ao).moves == 0);
+  CHECK(same.points == m.points);
+
+  ao.triangle_target = 1.5;  // triangles aim at 30 deg
+  CHECK(optimise_angles(m, locked, ao).moves > 0);
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    INFO("element " << e << ": q " << angle_quality(m, e));
+    CHECK(angle_quality(m, e) >= (m.solid.type[e] == ElemType::Tri3 ? 1.5 : 1.25));
+  }
+}
+
 TEST_CASE("the optimiser never inverts an element nor lowers the worst quality", "[optimise_angles][property]") {
   febemesh::test::prop("random jiggled grids", 100, [] {
     const int n = *rc::gen::inRange(2, 6);
