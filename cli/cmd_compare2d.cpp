@@ -113,6 +113,7 @@ int run(const std::vector<std::string>& argv) {
                  "max_angle_deg", "elements_below_30deg", "min_scaled_jacobian", "mean_scaled_jacobian",
                  "area_rel_error", "hausdorff_rel", "node_distance_rel"};
   report.quality_key = "min_angle_deg";
+  report.tolerance = copt.tolerance;
   // Quads have right angles where triangles have 60 degrees.
   const double best_angle = opt.elements == ElementKind::Tri ? 60.0 : 90.0;
   HistogramPlot angles{"min-angle.svg", "Smallest angle per element", "degrees", 0.0, best_angle, 30, {}};

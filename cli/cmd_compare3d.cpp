@@ -30,13 +30,15 @@ options:
   --iterations N     at most N TetGen runs to match the count (default 6)
   --quiet            no progress on stderr
 
-outputs in DIR: mesh.msh (ours, if it meshed), tetgen.msh, comparison.json ({"febemesh": {..},
+outputs in DIR: mesh.msh (ours, if it meshed), tetgen.msh, tetgen.log, comparison.json ({"febemesh": {..},
 "tetgen": {..}}: elements, nodes, wall_seconds, elements_per_second, peak_memory_bytes,
 min_dihedral_deg, max_dihedral_deg, slivers_below_10deg, volume_rel_error, hausdorff_rel, ...),
 comparison.md, min-dihedral.svg, max-dihedral.svg, radius-ratio.svg, scaled-jacobian.svg.
 Each tool runs single-threaded in a forked child, timed from reading the file to writing its
 .msh; peak_memory_bytes is the child's peak resident memory growth. A tool that fails is
-reported with "ok": false and its message verbatim.
+reported with "ok": false and its message verbatim (libtet 1.5 can crash while failing: then
+what TetGen printed, kept in tetgen.log). When TetGen's count cannot be brought within the
+tolerance (e.g. the input's triangles alone need more tets), comparison.md warns.
 exit status: 0 both tools meshed, 1 bad input or a tool failed, 2 bad usage.
 )";
 
@@ -102,6 +104,7 @@ int run(const std::vector<std::string>& argv) {
                  "min_scaled_jacobian", "mean_scaled_jacobian", "max_radius_ratio", "volume_rel_error",
                  "hausdorff_rel"};
   report.unit = "tets";
+  report.tolerance = copt.tolerance;
   report.quality_key = "min_dihedral_deg";
   HistogramPlot mind{"min-dihedral.svg", "Smallest dihedral angle per tetrahedron", "degrees", 0.0, 90.0, 30, {}};
   HistogramPlot maxd{"max-dihedral.svg", "Largest dihedral angle per tetrahedron", "degrees", 60.0, 180.0, 30, {}};

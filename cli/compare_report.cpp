@@ -117,14 +117,29 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
 }
 
 int finish_comparison(AtomicOutputDir& dir, const ComparisonOutput& out, bool quiet) {
-  write_text(dir.file("comparison.json"), out.json.dump(2) + "\n");
-  write_text(dir.file("comparison.md"), comparison_markdown(out.title, out.json, out.tools, out.keys));
+  nlohmann::ordered_json json = out.json;
+  std::string md = comparison_markdown(out.title, json, out.tools, out.keys);
+  if (json.contains("element_count_ratio")) {
+    const double ratio = json["element_count_ratio"].get<double>();
+    const bool within = std::abs(ratio - 1.0) <= out.tolerance;
+    json["element_count_within_tolerance"] = within;
+    if (!within) {
+      std::ostringstream w;
+      w << out.tools.at(1) << "'s element count is " << ratio << " x ours, outside the tolerance of "
+        << out.tolerance << " (its trials are in comparison.json): the rates and qualities compare meshes of "
+        << "different sizes";
+      md += "\n**Warning:** " + w.str() + ".\n";
+      if (!quiet) std::cerr << out.command << ": warning: " << w.str() << "\n";
+    }
+  }
+  write_text(dir.file("comparison.json"), json.dump(2) + "\n");
+  write_text(dir.file("comparison.md"), md);
   for (const HistogramPlot& p : out.plots)
     write_histogram_svg(dir.file(p.file), p.title, p.x_label, p.lo, p.hi, p.n_bins, p.series);
   dir.commit();
   bool all_ok = true;
   for (const std::string& tool : out.tools) {
-    const auto& t = out.json.at(tool);
+    const auto& t = json.at(tool);
     const bool ok = t.value("ok", false);
     all_ok = all_ok && ok;
     if (quiet) continue;

@@ -47,6 +47,10 @@ struct ComparisonOutput {
   std::vector<HistogramPlot> plots;
   std::string unit = "elements";     ///< for the progress lines: "elements", "tets"
   std::string quality_key;           ///< reported in the progress lines, e.g. "min_angle_deg"
+  /// Accepted relative difference of the element counts. When json's "element_count_ratio"
+  /// (theirs / ours) is outside 1 +- tolerance, comparison.json says so
+  /// ("element_count_within_tolerance": false), comparison.md and stderr carry a warning.
+  double tolerance = 0.2;
 };
 
 /// Writes comparison.json, comparison.md and the plots into `dir` and commits it; unless

@@ -9,6 +9,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -43,13 +44,15 @@ void write_all(int fd, const std::string& s) {
   }
 }
 
-/// Runs `f` with stdout going to a temporary file; returns what was printed. TetGen prints its
-/// diagnostics with printf before throwing.
-template <typename F> std::string capture_stdout(F&& f) {
+/// Runs `f` with stdout going to a temporary file, or unbuffered to `keep` when given (so that
+/// what was printed survives a crash); returns what was printed. TetGen prints its diagnostics
+/// with printf before throwing.
+template <typename F> std::string capture_stdout(F&& f, const std::string& keep) {
   std::fflush(stdout);
-  FILE* tmp = std::tmpfile();
+  FILE* tmp = keep.empty() ? std::tmpfile() : std::fopen(keep.c_str(), "w+");
   const int saved = ::dup(STDOUT_FILENO);
   if (tmp) ::dup2(::fileno(tmp), STDOUT_FILENO);
+  if (tmp && !keep.empty()) std::setvbuf(stdout, nullptr, _IONBF, 0);
   auto restore = [&] {
     std::fflush(stdout);
     if (saved >= 0) {
@@ -90,7 +93,7 @@ std::string tetgen_code_meaning(int code) {
   }
 }
 
-Mesh<3> tetgen_mesh(const TriangleSoup& soup, const std::string& switches) {
+Mesh<3> tetgen_mesh(const TriangleSoup& soup, const std::string& switches, const std::string& log_path) {
   tetgenio in, out;
   in.firstnumber = 0;
   in.numberofpoints = int(soup.vertices.size());
@@ -118,7 +121,7 @@ Mesh<3> tetgen_mesh(const TriangleSoup& soup, const std::string& switches) {
     } catch (int c) {  // libtet's way of failing (terminatetetgen)
       code = c;
     }
-  });
+  }, log_path);
   if (code != 0)
     throw TetgenError(code, "TetGen error code " + std::to_string(code) + " (" + tetgen_code_meaning(code) + ")" +
                                 (printed.empty() ? std::string() : ", TetGen printed:\n" + printed));
@@ -178,6 +181,9 @@ ChildResult run_in_child(const std::function<void()>& job) {
   if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
     ::close(fds[0]);
+    // A crash is the child's report (the parent sees the signal), not the caller's handlers'
+    // business (e.g. a test framework's, which would print a failure from the child).
+    for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
     {  // Reset the high-water mark so that VmHWM measures this job only (Linux >= 4.0).
       std::ofstream clear("/proc/self/clear_refs");
       clear << "5";
@@ -282,10 +288,20 @@ Comparison3d compare_with_tetgen(const std::string& surface_path, const Options3
     if (bound > 0) sw << "a" << bound;
     sw << "Q";
     c.tetgen_switches = sw.str();
+    const fs::path log = out / "tetgen.log";
     rt = run_in_child([&] {
-      const Mesh<3> m = tetgen_mesh(read_surface(surface_path), c.tetgen_switches);
+      const Mesh<3> m = tetgen_mesh(read_surface(surface_path), c.tetgen_switches, log.string());
       write_msh<3>(m, theirs);
     });
+    if (!rt.ok && rt.error.rfind("crashed", 0) == 0) {
+      // libtet 1.5 can crash in its own cleanup while failing, before its error code reaches
+      // us: what it printed is what there is to report.
+      std::ifstream in(log);
+      std::ostringstream printed;
+      printed << in.rdbuf();
+      rt.error = "TetGen " + rt.error + (printed.str().empty() ? std::string(", printing nothing")
+                                                               : ", after printing:\n" + printed.str());
+    }
     if (!rt.ok || target <= 0) break;
     const Mesh<3> m = read_msh<3>(theirs);
     const double n = double(m.solid.size());

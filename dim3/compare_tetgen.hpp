@@ -74,8 +74,11 @@ std::string tetgen_code_meaning(int code);
 
 /// Tetrahedralizes the closed surface `soup` with TetGen `switches` (e.g. "pq1.414/10a0.01Q").
 /// Solid = tets (positively oriented), interface = TetGen's boundary faces.
-/// Throws TetgenError with TetGen's code and printed output.
-Mesh<3> tetgen_mesh(const TriangleSoup& soup, const std::string& switches);
+/// Throws TetgenError with TetGen's code and printed output. What TetGen prints goes to
+/// `log_path` as it prints it, when given. Caution: libtet 1.5 can crash (SIGSEGV in its
+/// memory pools' cleanup) while failing, e.g. on a self-intersecting surface, so compare3d runs
+/// it in a child process (run_in_child) with a log.
+Mesh<3> tetgen_mesh(const TriangleSoup& soup, const std::string& switches, const std::string& log_path = "");
 
 struct CompareOptions3d {
   double tolerance = 0.2;

@@ -1,0 +1,103 @@
+// `febemesh compare3d` end to end on sphere966: both tools' keys in comparison.json, TetGen's
+// tet count matched within the tolerance (or a warning when it cannot be), the plots, and the
+// exit codes for bad input and bad usage.
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+int run_status(const std::string& args) {
+  const std::string cmd = std::string("'") + FEBEMESH_CLI + "' " + args + " >/dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::filesystem::path tmp_dir() {
+  const auto d = std::filesystem::temp_directory_path() / ("febemesh_compare3d_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+std::string sphere() { return std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off"; }
+
+nlohmann::json read_json(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return nlohmann::json::parse(in);
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both tools", "[cli][compare]") {
+  const auto out = tmp_dir() / "sphere";
+  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 4 --quiet") == 0);
+  const auto j = read_json(out / "comparison.json");
+  for (const char* tool : {"febemesh", "tetgen"}) {
+    INFO(tool);
+    REQUIRE(j.contains(tool));
+    CHECK(j[tool]["ok"] == true);
+    for (const char* key : {"elements", "nodes", "wall_seconds", "elements_per_second", "peak_memory_bytes",
+                            "min_dihedral_deg", "max_dihedral_deg", "slivers_below_10deg", "volume_rel_error",
+                            "hausdorff_rel"})
+      CHECK(j[tool].contains(key));
+    CHECK(j[tool]["min_dihedral_deg"].get<double>() > 0.0);
+    CHECK(j[tool]["max_dihedral_deg"].get<double>() < 180.0);
+    CHECK(j[tool]["peak_memory_bytes"].get<double>() > 0.0);
+    // Both meshes fill the sphere: volume within 2%, boundary within 2% of the diagonal.
+    CHECK(j[tool]["volume_rel_error"].get<double>() < 0.02);
+    CHECK(j[tool]["hausdorff_rel"].get<double>() < 0.02);
+  }
+  const double ours = j["febemesh"]["elements"].get<double>(), theirs = j["tetgen"]["elements"].get<double>();
+  CHECK(std::abs(theirs - ours) <= 0.2 * ours);
+  CHECK(j["element_count_within_tolerance"] == true);
+  CHECK(j["tetgen"]["switches"].get<std::string>().rfind("pq1.414/10a", 0) == 0);
+  // Our octree mesh has no slivers here (measured 28.0 deg smallest dihedral at level 4).
+  CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() >= 20.0);
+  CHECK(j["febemesh"]["slivers_below_10deg"].get<int>() == 0);
+  for (const char* f : {"comparison.md", "min-dihedral.svg", "max-dihedral.svg", "radius-ratio.svg",
+                        "scaled-jacobian.svg", "mesh.msh", "tetgen.msh", "tetgen.log"})
+    CHECK(std::filesystem::exists(out / f));
+  CHECK(read_text(out / "comparison.md").find("Warning") == std::string::npos);
+  std::filesystem::remove_all(out);
+}
+
+TEST_CASE("compare3d warns when TetGen cannot come down to our tet count", "[cli][compare]") {
+  // At level 3 we make ~2,800 tets; TetGen's smallest mesh of the 966 input triangles is ~4x more.
+  const auto out = tmp_dir() / "coarse";
+  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --quiet") == 0);
+  const auto j = read_json(out / "comparison.json");
+  CHECK(j["element_count_ratio"].get<double>() > 1.2);
+  CHECK(j["element_count_within_tolerance"] == false);
+  CHECK(read_text(out / "comparison.md").find("**Warning:** tetgen's element count is") != std::string::npos);
+  std::filesystem::remove_all(out);
+}
+
+TEST_CASE("compare3d refuses bad input and bad usage", "[cli][compare]") {
+  const auto dir = tmp_dir();
+  const auto out = dir / "open";
+  // Not closed: exit 1 and nothing written.
+  CHECK(run_status("compare3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/open-cylinder.off' -o '" + out.string() +
+                   "' --quiet") == 1);
+  CHECK(!std::filesystem::exists(out));
+  CHECK(run_status("compare3d '" + (dir / "missing.off").string() + "' -o '" + out.string() + "' --quiet") == 1);
+  CHECK(!std::filesystem::exists(out));
+  // Usage: no output folder, a level out of range, an unknown option.
+  CHECK(run_status("compare3d '" + sphere() + "'") == 2);
+  CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 99") == 2);
+  CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --frobnicate") == 2);
+  CHECK(!std::filesystem::exists(out));
+  std::filesystem::remove_all(dir);
+}
