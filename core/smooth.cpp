@@ -85,12 +85,20 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
   stats.min_quality_before = min_quality(state);
+  // settled[v]: 1 if v's target was where it stands, 2 if its move was rejected, and no node of
+  // its elements has moved since; its target, its elements' states and the trial states would
+  // be the same numbers, so the same outcome: it is skipped (and counted as before).
+  std::vector<std::uint8_t> settled(n, 0);
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
     for (std::size_t v = 0; v < n; ++v) {
       if (!options.fixed.empty() && options.fixed[v]) continue;
       const bool slides = on_boundary[v] != 0;
       if (slides && !options.project) continue;
+      if (settled[v]) {
+        stats.moves_rejected += settled[v] == 2;
+        continue;
+      }
       const auto nbrs = slides ? boundary_neighbours.of(static_cast<std::int32_t>(v)) : neighbours.of(static_cast<std::int32_t>(v));
       const auto elems = incident.of(static_cast<std::int32_t>(v));
       if (nbrs.empty() || elems.empty()) continue;
@@ -98,7 +106,10 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       for (const auto w : nbrs) target += mesh.points[w];
       target /= static_cast<double>(nbrs.size());
       if (slides) target = options.project(target);
-      if (target == mesh.points[v]) continue;
+      if (target == mesh.points[v]) {
+        settled[v] = 1;
+        continue;
+      }
 
       double old_min = std::numeric_limits<double>::infinity();
       std::size_t worst = 0;
@@ -119,10 +130,16 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       }
       if (accept) {
         ++stats.moves_accepted;
-        for (std::size_t k = 0; k < elems.size(); ++k) state[elems[k]] = after[k];
+        for (std::size_t k = 0; k < elems.size(); ++k) {
+          state[elems[k]] = after[k];
+          const ElemId id{elems[k]};
+          const VertexId* ev = mesh.solid.nodes(id);
+          for (int j = 0; j < mesh.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+        }
       } else {
         mesh.points[v] = saved;
         ++stats.moves_rejected;
+        settled[v] = 2;
       }
     }
   }

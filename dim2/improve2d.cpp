@@ -163,6 +163,10 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   const double good = 44.0;
   std::vector<EdgeKey> candidates;
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
+  // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
+  // has any of its elements flipped since; its target, its elements' angles and the trial
+  // angles would be the same numbers, so it would be rejected again and is skipped.
+  std::vector<std::uint8_t> settled(n_nodes, 0);
   std::vector<std::int32_t> nb;
   std::vector<double> trial;
   for (int round = 0; round < rounds; ++round) {
@@ -211,6 +215,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
+        settled[a] = settled[b] = settled[c] = settled[d] = 0;
         angle[e0] = min_corner_angle_deg(m, static_cast<std::size_t>(e0));
         angle[e1] = min_corner_angle_deg(m, static_cast<std::size_t>(e1));
         ++flips;
@@ -224,7 +229,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     for (std::size_t v = 0; v < n_nodes; ++v) {
       const bool sliding = locked[v] == 2 && slide;
       const auto elems = incident.of(static_cast<std::int32_t>(v));
-      if ((locked[v] && !sliding) || elems.empty()) continue;
+      if ((locked[v] && !sliding) || elems.empty() || settled[v]) continue;
       if (sliding) {
         nb = curve_neighbours[v];
       } else {
@@ -275,9 +280,15 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
       if (moved) {
         ++st.moves;
-        for (std::size_t k = 0; k < elems.size(); ++k) angle[elems[k]] = trial[k];  // the accepted trial's
+        for (std::size_t k = 0; k < elems.size(); ++k) {
+          angle[elems[k]] = trial[k];  // the accepted trial's
+          const ElemId id{elems[k]};
+          const VertexId* ev = m.solid.nodes(id);
+          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+        }
       } else {
         m.points[v] = saved;
+        settled[v] = 1;
       }
     }
   }
