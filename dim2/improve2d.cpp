@@ -21,7 +21,7 @@ double cross(const P2& a, const P2& b, const P2& c) {
 /// Corner angle (degrees) from its cross and dot products.
 double corner_angle(double cr, double dot) { return std::atan2(std::abs(cr), dot) * 180.0 / M_PI; }
 
-/// Slow twin of polygon_min_angle: every corner's atan2.
+/// Slow twin of polygon_min_angle_n: every corner's atan2.
 double polygon_min_angle_ref(const P2* pts, int n) {
   double best = 180.0;
   for (int k = 0; k < n; ++k) {
@@ -37,10 +37,10 @@ double polygon_min_angle_ref(const P2* pts, int n) {
 /// Cost: the angle is decreasing in its cotangent dot/|cross|, so atan2 runs only for the
 /// corners whose cotangent is within a margin of the largest (ties and near-ties: all of them).
 /// The margin (1e-7 relative) dwarfs the rounding of the quotients and of atan2, so the minimum
-/// is the one polygon_min_angle_ref takes, bit for bit.
-double polygon_min_angle(const P2* pts, int n) {
-  MESH_ASSERT(n >= 3 && n <= 4, "polygon of " << n << " corners");
-  double cr[4], dot[4], cot[4];
+/// is the one polygon_min_angle_ref takes, bit for bit. n (3 or 4) is a template parameter so
+/// that the loops unroll.
+template <int n> double polygon_min_angle_n(const P2* pts) {
+  double cr[n], dot[n], cot[n];
   for (int k = 0; k < n; ++k) {
     const P2 &prev = pts[(k + n - 1) % n], &cur = pts[k], &next = pts[(k + 1) % n];
     if (cross(prev, cur, next) <= 0) return -1.0;
@@ -61,18 +61,24 @@ double polygon_min_angle(const P2* pts, int n) {
 
 double tri_min_angle(const P2& a, const P2& b, const P2& c) {
   const P2 p[3] = {a, b, c};
-  return polygon_min_angle(p, 3);
+  return polygon_min_angle_n<3>(p);
+}
+
+/// min_corner_angle_deg, inlined where the quality pass evaluates its trials.
+inline double element_min_angle(const Mesh<2>& m, std::size_t e) {
+  const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+  if (m.solid.offset[e + 1] - m.solid.offset[e] == 3) {
+    const P2 p[3] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v]};
+    return polygon_min_angle_n<3>(p);
+  }
+  MESH_ASSERT(m.solid.offset[e + 1] - m.solid.offset[e] == 4, "element " << e);
+  const P2 p[4] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]};
+  return polygon_min_angle_n<4>(p);
 }
 
 }  // namespace
 
-double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) {
-  const ElemId id{static_cast<std::int32_t>(e)};
-  const int n = m.solid.n_nodes_of(id);
-  std::array<P2, 4> p;
-  for (int k = 0; k < n; ++k) p[k] = m.points[m.solid.nodes(id)[k].v];
-  return polygon_min_angle(p.data(), n);
-}
+double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) { return element_min_angle(m, e); }
 
 double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e) {
   const ElemId id{static_cast<std::int32_t>(e)};
@@ -128,7 +134,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
   std::vector<double> angle(m.solid.size());
-  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = min_corner_angle_deg(m, e);
+  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = element_min_angle(m, e);
   auto mesh_min = [&] {
     double q = 180.0;
     for (const double a : angle) q = std::min(q, a);
@@ -216,8 +222,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
-        angle[e0] = min_corner_angle_deg(m, static_cast<std::size_t>(e0));
-        angle[e1] = min_corner_angle_deg(m, static_cast<std::size_t>(e1));
+        angle[e0] = element_min_angle(m, static_cast<std::size_t>(e0));
+        angle[e1] = element_min_angle(m, static_cast<std::size_t>(e1));
         ++flips;
       }
       st.flips += flips;
@@ -270,7 +276,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         bool better = true;
         for (std::size_t j = 0; j < elems.size() && better; ++j) {
           const std::size_t k = worst_first(j, worst);
-          trial[k] = min_corner_angle_deg(m, static_cast<std::size_t>(elems[k]));
+          trial[k] = element_min_angle(m, static_cast<std::size_t>(elems[k]));
           better = trial[k] > old_q + 1e-12;
         }
         if (better) {
