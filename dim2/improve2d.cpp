@@ -115,6 +115,45 @@ struct Incidence {
   }
 };
 
+/// The triangles at some of the nodes (CSR over those nodes only, triangles in increasing
+/// order, as Incidence(m, true) lists them): a flip pass looks up only the smaller ends of its
+/// candidate edges, the boundary layer, so it need not index every node.
+class SomeTriangles {
+ public:
+  explicit SomeTriangles(std::size_t n_nodes) : slot_(n_nodes, -1) {}
+  /// Rebuilds the lists for `nodes` (distinct) from the triangles of m.
+  void build(const Mesh<2>& m, const std::vector<std::int32_t>& nodes) {
+    for (const std::int32_t v : nodes_) slot_[v] = -1;
+    nodes_ = nodes;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) slot_[nodes_[i]] = static_cast<std::int32_t>(i);
+    start_.assign(nodes_.size() + 1, 0);
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (m.solid.type[e] != ElemType::Tri3) continue;
+      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+      for (int k = 0; k < 3; ++k)
+        if (const std::int32_t s = slot_[v[k].v]; s >= 0) ++start_[s + 1];
+    }
+    for (std::size_t i = 0; i < nodes_.size(); ++i) start_[i + 1] += start_[i];
+    elem_.resize(start_.back());
+    fill_.assign(start_.begin(), start_.end() - 1);
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (m.solid.type[e] != ElemType::Tri3) continue;
+      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+      for (int k = 0; k < 3; ++k)
+        if (const std::int32_t s = slot_[v[k].v]; s >= 0) elem_[fill_[s]++] = static_cast<std::int32_t>(e);
+    }
+  }
+  /// Requires v among the nodes of the last build.
+  std::span<const std::int32_t> of(std::int32_t v) const {
+    const std::int32_t s = slot_[v];
+    MESH_ASSERT(s >= 0, "node " << v << " not indexed");
+    return {elem_.data() + start_[s], static_cast<std::size_t>(start_[s + 1] - start_[s])};
+  }
+
+ private:
+  std::vector<std::int32_t> slot_, nodes_, start_, elem_, fill_;
+};
+
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
 int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -168,6 +207,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // 45 degrees already, so flipping costs little beyond the boundary layer.
   const double good = 44.0;
   std::vector<EdgeKey> candidates;
+  std::vector<std::int32_t> lows;  // the candidates' smaller ends (distinct: keys are sorted)
+  SomeTriangles tris(n_nodes);
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
   // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
   // has any of its elements flipped since; its target, its elements' angles and the trial
@@ -189,7 +230,10 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
       // are skipped for the rest of the pass.
-      const Incidence tris(m, true);
+      lows.clear();
+      for (const EdgeKey key : candidates)
+        if (const auto lo = static_cast<std::int32_t>(key >> 32); lows.empty() || lows.back() != lo) lows.push_back(lo);
+      tris.build(m, lows);
       std::fill(touched.begin(), touched.end(), 0);
       std::size_t flips = 0;
       for (const EdgeKey key : candidates) {
