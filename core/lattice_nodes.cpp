@@ -12,25 +12,37 @@ namespace febemesh {
 
 namespace {
 
-/// Sorts `keys` ascending: LSD radix sort by bytes, skipping the bytes in which all keys agree
-/// (a stable pass on a constant digit changes nothing). Linear; `scratch` is reused.
-void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch) {
-  if (keys.size() < 1024) {
-    std::sort(keys.begin(), keys.end());
+/// Sorts [first, last) ascending: in-place MSD radix sort (American flag) on the byte at `shift`
+/// and below, short ranges by std::sort. Linear in practice and no scratch buffer (this runs at
+/// the boundary stage's memory peak).
+void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
+  if (last - first < 64 || shift < 0) {
+    std::sort(first, last);
     return;
   }
+  auto digit = [shift](std::uint64_t k) { return static_cast<std::size_t>((k >> shift) & 0xffu); };
+  std::array<std::size_t, 257> start{};
+  for (const std::uint64_t* p = first; p != last; ++p) ++start[digit(*p) + 1];
+  for (int b = 0; b < 256; ++b) start[b + 1] += start[b];
+  std::array<std::size_t, 256> head;
+  std::copy(start.begin(), start.end() - 1, head.begin());
+  for (std::size_t b = 0; b < 256; ++b) {
+    while (head[b] < start[b + 1]) {
+      std::uint64_t v = first[head[b]];
+      for (std::size_t d = digit(v); d != b; d = digit(v)) std::swap(v, first[head[d]++]);
+      first[head[b]++] = v;
+    }
+  }
+  for (std::size_t b = 0; b < 256; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
+}
+
+/// Sorts `keys` ascending, starting at the highest byte in which they differ.
+void radix_sort(std::vector<std::uint64_t>& keys) {
   std::uint64_t any = 0, all = ~std::uint64_t{0};
   for (const std::uint64_t k : keys) any |= k, all &= k;
-  const std::uint64_t varying = any ^ all;
-  scratch.resize(keys.size());
-  for (int shift = 0; shift < 64; shift += 8) {
-    if (((varying >> shift) & 0xffu) == 0) continue;
-    std::array<std::size_t, 257> start{};
-    for (const std::uint64_t k : keys) ++start[((k >> shift) & 0xffu) + 1];
-    for (int b = 0; b < 256; ++b) start[b + 1] += start[b];
-    for (const std::uint64_t k : keys) scratch[start[(k >> shift) & 0xffu]++] = k;
-    keys.swap(scratch);
-  }
+  int shift = 56;
+  while (shift > 0 && (((any ^ all) >> shift) & 0xffu) == 0) shift -= 8;
+  radix_sort(keys.data(), keys.data() + keys.size(), shift);
 }
 
 /// std::lower_bound(keys, key) as an index, found by galloping outward from `hint`: the same
@@ -94,10 +106,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
     if (!kept(i)) continue;
     for (int k = 0; k < n_corners; ++k) keys.push_back(point_key<Dim>(corner(t.leaf(i), k)));
   }
-  {
-    std::vector<std::uint64_t> scratch;
-    radix_sort(keys, scratch);
-  }
+  radix_sort(keys);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
     throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
