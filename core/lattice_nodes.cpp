@@ -3,11 +3,86 @@
 // kept leaves around it has it on its boundary without having it as a corner.
 
 #include <algorithm>
+#include <array>
 
 #include "core/error.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
+
+namespace {
+
+/// Sorts [first, last) ascending: in-place MSD radix sort (American flag) on the byte at `shift`
+/// and below, short ranges by std::sort. Linear in practice and no scratch buffer (this runs at
+/// the boundary stage's memory peak).
+void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
+  if (last - first < 64 || shift < 0) {
+    std::sort(first, last);
+    return;
+  }
+  auto digit = [shift](std::uint64_t k) { return static_cast<std::size_t>((k >> shift) & 0xffu); };
+  std::array<std::size_t, 257> start{};
+  for (const std::uint64_t* p = first; p != last; ++p) ++start[digit(*p) + 1];
+  for (int b = 0; b < 256; ++b) start[b + 1] += start[b];
+  std::array<std::size_t, 256> head;
+  std::copy(start.begin(), start.end() - 1, head.begin());
+  for (std::size_t b = 0; b < 256; ++b) {
+    while (head[b] < start[b + 1]) {
+      std::uint64_t v = first[head[b]];
+      for (std::size_t d = digit(v); d != b; d = digit(v)) std::swap(v, first[head[d]++]);
+      first[head[b]++] = v;
+    }
+  }
+  for (std::size_t b = 0; b < 256; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
+}
+
+/// Sorts `keys` ascending, starting at the highest byte in which they differ.
+void radix_sort(std::vector<std::uint64_t>& keys) {
+  std::uint64_t any = 0, all = ~std::uint64_t{0};
+  for (const std::uint64_t k : keys) any |= k, all &= k;
+  int shift = 56;
+  while (shift > 0 && (((any ^ all) >> shift) & 0xffu) == 0) shift -= 8;
+  radix_sort(keys.data(), keys.data() + keys.size(), shift);
+}
+
+/// std::lower_bound(keys, key) as an index, found by galloping outward from `hint`: the same
+/// answer in O(log distance) steps (the corners of consecutive leaves lie close in Morton order).
+std::size_t lower_bound_from(const std::vector<std::uint64_t>& keys, std::uint64_t key, std::size_t hint) {
+  const std::size_t n = keys.size();
+  hint = std::min(hint, n);
+  std::size_t lo = 0, hi = 0;  // the answer lies in [lo, hi]
+  if (hint < n && keys[hint] < key) {
+    lo = hint + 1;
+    for (std::size_t step = 1;; step *= 2) {
+      hi = lo + step - 1;
+      if (hi >= n) {
+        hi = n;
+        break;
+      }
+      if (keys[hi] >= key) break;
+      lo = hi + 1;
+    }
+  } else {
+    hi = hint;
+    for (std::size_t step = 1;; step *= 2) {
+      if (hi < step) {
+        lo = 0;
+        break;
+      }
+      const std::size_t probe = hi - step;
+      if (keys[probe] < key) {
+        lo = probe + 1;
+        break;
+      }
+      hi = probe;
+    }
+  }
+  return static_cast<std::size_t>(std::lower_bound(keys.begin() + static_cast<std::ptrdiff_t>(lo),
+                                                   keys.begin() + static_cast<std::ptrdiff_t>(hi), key) -
+                                  keys.begin());
+}
+
+}  // namespace
 
 template <int Dim> std::int32_t LatticeNodes<Dim>::find(const LatticePoint<Dim>& p) const {
   const std::uint64_t key = point_key<Dim>(p);
@@ -31,7 +106,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
     if (!kept(i)) continue;
     for (int k = 0; k < n_corners; ++k) keys.push_back(point_key<Dim>(corner(t.leaf(i), k)));
   }
-  std::sort(keys.begin(), keys.end());
+  radix_sort(keys);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
     throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
@@ -42,6 +117,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   for (const std::uint64_t k : keys) nodes.points.push_back(point_from_key<Dim>(k));
 
   nodes.leaf_corners.resize(t.n_leaves());
+  std::array<std::size_t, n_corners> near{};  // corner k's answer for the previous kept leaf
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     auto& row = nodes.leaf_corners[i];
     for (int k = 0; k < n_corners; ++k) {
@@ -50,7 +126,8 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
         continue;
       }
       const std::uint64_t key = point_key<Dim>(corner(t.leaf(i), k));
-      row[k] = std::int32_t(std::lower_bound(keys.begin(), keys.end(), key) - keys.begin());
+      near[k] = lower_bound_from(keys, key, near[k]);
+      row[k] = std::int32_t(near[k]);
     }
   }
 

@@ -237,8 +237,20 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid) {
     std::int32_t second;  ///< key.v[1]
     std::int32_t third;   ///< key.v[2]; -1 for an edge, and then key.v[3] is -1 too
   };
+  // The facets of triangles and quadrilaterals are their edges (k, k+1): the key is read off
+  // the nodes (key_of(facet_of()) gives the same key, through the tables).
   auto key = [&](std::uint32_t id) {
-    return key_of(facet_of(solid, ElemId{static_cast<std::int32_t>(id >> facet_bits)}, static_cast<int>(id & 7u)));
+    const auto e = static_cast<std::int32_t>(id >> facet_bits);
+    const int f = static_cast<int>(id & 7u);
+    const ElemType t = solid.type[static_cast<std::size_t>(e)];
+    if (t != ElemType::Tri3 && t != ElemType::Quad4) return key_of(facet_of(solid, ElemId{e}, f));
+    const VertexId* nodes = solid.nodes(ElemId{e});
+    const int n = t == ElemType::Tri3 ? 3 : 4;
+    const std::int32_t a = nodes[f].v, b = nodes[f + 1 == n ? 0 : f + 1].v;
+    FacetKey k;
+    k.v[0] = std::min(a, b);
+    k.v[1] = std::max(a, b);
+    return k;
   };
   std::int64_t top = -1;
   for (const VertexId v : solid.node) top = std::max<std::int64_t>(top, v.v);

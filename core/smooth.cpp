@@ -22,28 +22,72 @@ struct Csr {
   }
 };
 
-Csr build_csr(std::size_t n, const std::vector<std::pair<std::int32_t, std::int32_t>>& pairs) {
+/// Node -> its distinct edge neighbours in `els`, ascending: the lists the pairs of
+/// unique_edges(els) taken both ways gave (an edge (v, v) of a degenerate element lists v
+/// twice there, and here). Built by counting, without the edge and pair lists (memory peak).
+Csr edge_neighbours(std::size_t n, const Elements& els) {
   Csr g;
   g.start.assign(n + 1, 0);
-  for (const auto& [a, b] : pairs) {
-    (void)b;
-    ++g.start[a + 1];
-  }
+  auto each_edge = [&](auto&& visit) {
+    for (std::size_t e = 0; e < els.size(); ++e) {
+      const VertexId* nodes = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+      const ElemType t = els.type[e];
+      if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
+        const int n = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
+        for (int k = 0; k < n; ++k) visit(nodes[k].v, nodes[k + 1 == n ? (n == 1 ? 1 : 0) : k + 1].v);
+        continue;
+      }
+      for (int k = 0; k < n_edges(els.type[e]); ++k) {
+        const auto [a, b] = edge_local_nodes(els.type[e], k);
+        visit(nodes[a].v, nodes[b].v);
+      }
+    }
+  };
+  each_edge([&](std::int32_t u, std::int32_t w) { ++g.start[u + 1], ++g.start[w + 1]; });
   for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
-  g.item.resize(pairs.size());
+  g.item.resize(g.start[n]);
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
-  for (const auto& [a, b] : pairs) g.item[fill[a]++] = b;
+  each_edge([&](std::int32_t u, std::int32_t w) { g.item[fill[u]++] = w, g.item[fill[w]++] = u; });
+  fill = {};
+  // Sort and deduplicate each node's list, compacting in place (a list only shrinks).
+  std::int32_t out = 0, begin = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    const std::int32_t end = g.start[v + 1];
+    auto first = g.item.begin() + begin, last = g.item.begin() + end;
+    if (last - first > 32) {
+      std::sort(first, last);
+    } else {
+      for (auto i = first + (first != last); i < last; ++i)
+        for (auto j = i; j != first && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+    }
+    last = std::unique(first, last);
+    const bool self = std::binary_search(first, last, static_cast<std::int32_t>(v));
+    g.start[v] = out;
+    for (auto it = first; it != last; ++it) {
+      g.item[out++] = *it;
+      if (self && *it == static_cast<std::int32_t>(v)) g.item[out++] = *it;
+    }
+    begin = end;
+  }
+  g.start[n] = out;
+  g.item.resize(static_cast<std::size_t>(out));
+  g.item.shrink_to_fit();
   return g;
 }
 
-std::vector<std::pair<std::int32_t, std::int32_t>> both_ways(const std::vector<std::array<VertexId, 2>>& edges) {
-  std::vector<std::pair<std::int32_t, std::int32_t>> pairs;
-  pairs.reserve(2 * edges.size());
-  for (const auto& [a, b] : edges) {
-    pairs.emplace_back(a.v, b.v);
-    pairs.emplace_back(b.v, a.v);
+/// Node -> the elements that use it, in increasing order (once per use).
+Csr incident_elements(std::size_t n, const Elements& els) {
+  Csr g;
+  g.start.assign(n + 1, 0);
+  for (const VertexId v : els.node) ++g.start[v.v + 1];
+  for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
+  g.item.resize(g.start[n]);
+  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int i = 0; i < els.n_nodes_of(id); ++i) g.item[fill[els.nodes(id)[i].v]++] = id.v;
   }
-  return pairs;
+  return g;
 }
 
 }  // namespace
@@ -53,20 +97,15 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   MESH_ASSERT(options.fixed.empty() || options.fixed.size() == n, "fixed has " << options.fixed.size() << " entries");
   SmoothStats stats;
 
-  const Csr neighbours = build_csr(n, both_ways(unique_edges(mesh.solid)));
+  const Csr neighbours = edge_neighbours(n, mesh.solid);
   Elements boundary;
   std::vector<std::uint8_t> on_boundary(n, 0);
   for (const BoundaryFacet& b : boundary_facets(mesh.solid)) {
     boundary.add(b.facet.type, b.facet.node.data(), b.facet.n);
     for (int i = 0; i < b.facet.n; ++i) on_boundary[b.facet.node[i].v] = 1;
   }
-  const Csr boundary_neighbours = build_csr(n, both_ways(unique_edges(boundary)));
-  std::vector<std::pair<std::int32_t, std::int32_t>> node_elem;
-  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int i = 0; i < mesh.solid.n_nodes_of(id); ++i) node_elem.emplace_back(mesh.solid.nodes(id)[i].v, id.v);
-  }
-  const Csr incident = build_csr(n, node_elem);
+  const Csr boundary_neighbours = edge_neighbours(n, boundary);
+  const Csr incident = incident_elements(n, mesh.solid);
 
   auto element_state = [&](std::int32_t e) {
     const auto ep = element_points<Dim>(mesh.solid, ElemId{e}, mesh.points);
@@ -85,12 +124,20 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
   stats.min_quality_before = min_quality(state);
+  // settled[v]: 1 if v's target was where it stands, 2 if its move was rejected, and no node of
+  // its elements has moved since; its target, its elements' states and the trial states would
+  // be the same numbers, so the same outcome: it is skipped (and counted as before).
+  std::vector<std::uint8_t> settled(n, 0);
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
     for (std::size_t v = 0; v < n; ++v) {
       if (!options.fixed.empty() && options.fixed[v]) continue;
       const bool slides = on_boundary[v] != 0;
       if (slides && !options.project) continue;
+      if (settled[v]) {
+        stats.moves_rejected += settled[v] == 2;
+        continue;
+      }
       const auto nbrs = slides ? boundary_neighbours.of(static_cast<std::int32_t>(v)) : neighbours.of(static_cast<std::int32_t>(v));
       const auto elems = incident.of(static_cast<std::int32_t>(v));
       if (nbrs.empty() || elems.empty()) continue;
@@ -98,7 +145,10 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       for (const auto w : nbrs) target += mesh.points[w];
       target /= static_cast<double>(nbrs.size());
       if (slides) target = options.project(target);
-      if (target == mesh.points[v]) continue;
+      if (target == mesh.points[v]) {
+        settled[v] = 1;
+        continue;
+      }
 
       double old_min = std::numeric_limits<double>::infinity();
       std::size_t worst = 0;
@@ -119,10 +169,16 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       }
       if (accept) {
         ++stats.moves_accepted;
-        for (std::size_t k = 0; k < elems.size(); ++k) state[elems[k]] = after[k];
+        for (std::size_t k = 0; k < elems.size(); ++k) {
+          state[elems[k]] = after[k];
+          const ElemId id{elems[k]};
+          const VertexId* ev = mesh.solid.nodes(id);
+          for (int j = 0; j < mesh.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+        }
       } else {
         mesh.points[v] = saved;
         ++stats.moves_rejected;
+        settled[v] = 2;
       }
     }
   }

@@ -53,6 +53,68 @@ template <class Num> void array(Text& out, const char* type, const char* name, i
   out << "        </DataArray>\n";
 }
 
+/// The element whose facet interface element e is, for every e: the one solid element that uses
+/// that facet, or -1 when none or several do (then it is not a boundary facet).
+template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& mesh) {
+  const Elements &solid = mesh.solid, &inter = mesh.interface;
+  std::vector<std::int32_t> out(inter.size(), -1);
+  const bool polygons = Dim == 2 && std::all_of(solid.type.begin(), solid.type.end(), [](ElemType t) {
+    return t == ElemType::Tri3 || t == ElemType::Quad4;
+  }) && std::all_of(inter.type.begin(), inter.type.end(), [](ElemType t) { return t == ElemType::Line2; });
+  if (!polygons) {
+    std::vector<std::pair<FacetKey, ElemId>> owner;
+    for (const BoundaryFacet& b : boundary_facets(solid)) owner.emplace_back(key_of(b.facet), b.elem);
+    std::sort(owner.begin(), owner.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t e = 0; e < inter.size(); ++e) {
+      const FacetKey k = key_of(as_facet(inter, ElemId{static_cast<std::int32_t>(e)}));
+      const auto it = std::lower_bound(owner.begin(), owner.end(), k, [](const auto& o, const FacetKey& key) { return o.first < key; });
+      if (it != owner.end() && it->first == k) out[e] = it->second.v;
+    }
+    return out;
+  }
+  // Polygons: the facets are the edges (k, k+1), so the users of edge {a, b} are among the
+  // elements at its smaller node; those of the interface's smaller nodes are listed (CSR).
+  std::vector<std::int32_t> slot(mesh.points.size(), -1), start, elem;
+  std::int32_t n_slots = 0;
+  for (std::size_t e = 0; e < inter.size(); ++e) {
+    const VertexId* v = inter.nodes(ElemId{static_cast<std::int32_t>(e)});
+    std::int32_t& s = slot[std::min(v[0].v, v[1].v)];
+    if (s < 0) s = n_slots++;
+  }
+  start.assign(static_cast<std::size_t>(n_slots) + 1, 0);
+  for (std::size_t e = 0; e < solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int k = 0; k < solid.n_nodes_of(id); ++k)
+      if (const std::int32_t s = slot[solid.nodes(id)[k].v]; s >= 0) ++start[s + 1];
+  }
+  for (std::int32_t i = 0; i < n_slots; ++i) start[i + 1] += start[i];
+  elem.resize(start.back());
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t e = 0; e < solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int k = 0; k < solid.n_nodes_of(id); ++k)
+      if (const std::int32_t s = slot[solid.nodes(id)[k].v]; s >= 0) elem[fill[s]++] = id.v;
+  }
+  for (std::size_t e = 0; e < inter.size(); ++e) {
+    const VertexId* v = inter.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const std::int32_t lo = std::min(v[0].v, v[1].v), hi = std::max(v[0].v, v[1].v), s = slot[lo];
+    int uses = 0;
+    std::int32_t user = -1;
+    for (std::int32_t i = start[s]; i < start[s + 1]; ++i) {
+      const ElemId id{elem[i]};
+      if (i > start[s] && elem[i - 1] == id.v) continue;  // listed once per use of lo
+      const int n = solid.n_nodes_of(id);
+      const VertexId* w = solid.nodes(id);
+      for (int k = 0; k < n; ++k) {
+        const std::int32_t p = w[k].v, q = w[k + 1 == n ? 0 : k + 1].v;
+        if (std::min(p, q) == lo && std::max(p, q) == hi) ++uses, user = id.v;
+      }
+    }
+    if (uses == 1) out[e] = user;
+  }
+  return out;
+}
+
 }  // namespace
 
 template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh) {
@@ -82,15 +144,10 @@ template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh) {
     from_boundary.push_back(e < mesh.from_boundary_cell.size() ? mesh.from_boundary_cell[e] : 0);
   }
   if (ni != 0) {
-    std::vector<std::pair<FacetKey, ElemId>> owner;
-    for (const BoundaryFacet& b : boundary_facets(mesh.solid)) owner.emplace_back(key_of(b.facet), b.elem);
-    std::sort(owner.begin(), owner.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    const std::vector<std::int32_t> owner = interface_owners<Dim>(mesh);
     for (std::size_t e = 0; e < ni; ++e) {
-      const FacetKey k = key_of(as_facet(mesh.interface, ElemId{static_cast<std::int32_t>(e)}));
-      const auto it = std::lower_bound(owner.begin(), owner.end(), k, [](const auto& o, const FacetKey& key) { return o.first < key; });
-      const bool found = it != owner.end() && it->first == k;
-      level.push_back(found ? level[it->second.v] : 0);
-      from_boundary.push_back(found ? from_boundary[it->second.v] : 0);
+      level.push_back(owner[e] >= 0 ? level[owner[e]] : 0);
+      from_boundary.push_back(owner[e] >= 0 ? from_boundary[owner[e]] : 0);
     }
   }
 

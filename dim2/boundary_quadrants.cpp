@@ -208,6 +208,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   };
 
   // Interior quadrants: CCW rings with hanging mid-edge nodes.
+  qc.interior.reserve(static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!in[i]) continue;
     const Cell<2>& c = t.leaf(i);

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <span>
 
 #include "core/error.hpp"
 #include "core/svg_canvas.hpp"
@@ -47,7 +48,7 @@ void draw_tree(SvgCanvas& c, const Orthtree<2>& t, const Flags* in) {
   }
 }
 
-std::vector<P2> ring_points(const std::vector<P2>& pts, const std::vector<std::int32_t>& ids) {
+std::vector<P2> ring_points(const std::vector<P2>& pts, std::span<const std::int32_t> ids) {
   std::vector<P2> out;
   for (std::int32_t i : ids) out.push_back(pts[i]);
   return out;

@@ -21,7 +21,7 @@ double cross(const P2& a, const P2& b, const P2& c) {
 /// Corner angle (degrees) from its cross and dot products.
 double corner_angle(double cr, double dot) { return std::atan2(std::abs(cr), dot) * 180.0 / M_PI; }
 
-/// Slow twin of polygon_min_angle: every corner's atan2.
+/// Slow twin of polygon_min_angle_n: every corner's atan2.
 double polygon_min_angle_ref(const P2* pts, int n) {
   double best = 180.0;
   for (int k = 0; k < n; ++k) {
@@ -37,10 +37,10 @@ double polygon_min_angle_ref(const P2* pts, int n) {
 /// Cost: the angle is decreasing in its cotangent dot/|cross|, so atan2 runs only for the
 /// corners whose cotangent is within a margin of the largest (ties and near-ties: all of them).
 /// The margin (1e-7 relative) dwarfs the rounding of the quotients and of atan2, so the minimum
-/// is the one polygon_min_angle_ref takes, bit for bit.
-double polygon_min_angle(const P2* pts, int n) {
-  MESH_ASSERT(n >= 3 && n <= 4, "polygon of " << n << " corners");
-  double cr[4], dot[4], cot[4];
+/// is the one polygon_min_angle_ref takes, bit for bit. n (3 or 4) is a template parameter so
+/// that the loops unroll.
+template <int n> double polygon_min_angle_n(const P2* pts) {
+  double cr[n], dot[n], cot[n];
   for (int k = 0; k < n; ++k) {
     const P2 &prev = pts[(k + n - 1) % n], &cur = pts[k], &next = pts[(k + 1) % n];
     if (cross(prev, cur, next) <= 0) return -1.0;
@@ -61,18 +61,24 @@ double polygon_min_angle(const P2* pts, int n) {
 
 double tri_min_angle(const P2& a, const P2& b, const P2& c) {
   const P2 p[3] = {a, b, c};
-  return polygon_min_angle(p, 3);
+  return polygon_min_angle_n<3>(p);
+}
+
+/// min_corner_angle_deg, inlined where the quality pass evaluates its trials.
+inline double element_min_angle(const Mesh<2>& m, std::size_t e) {
+  const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+  if (m.solid.offset[e + 1] - m.solid.offset[e] == 3) {
+    const P2 p[3] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v]};
+    return polygon_min_angle_n<3>(p);
+  }
+  MESH_ASSERT(m.solid.offset[e + 1] - m.solid.offset[e] == 4, "element " << e);
+  const P2 p[4] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]};
+  return polygon_min_angle_n<4>(p);
 }
 
 }  // namespace
 
-double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) {
-  const ElemId id{static_cast<std::int32_t>(e)};
-  const int n = m.solid.n_nodes_of(id);
-  std::array<P2, 4> p;
-  for (int k = 0; k < n; ++k) p[k] = m.points[m.solid.nodes(id)[k].v];
-  return polygon_min_angle(p.data(), n);
-}
+double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) { return element_min_angle(m, e); }
 
 double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e) {
   const ElemId id{static_cast<std::int32_t>(e)};
@@ -109,6 +115,45 @@ struct Incidence {
   }
 };
 
+/// The triangles at some of the nodes (CSR over those nodes only, triangles in increasing
+/// order, as Incidence(m, true) lists them): a flip pass looks up only the smaller ends of its
+/// candidate edges, the boundary layer, so it need not index every node.
+class SomeTriangles {
+ public:
+  explicit SomeTriangles(std::size_t n_nodes) : slot_(n_nodes, -1) {}
+  /// Rebuilds the lists for `nodes` (distinct) from the triangles of m.
+  void build(const Mesh<2>& m, const std::vector<std::int32_t>& nodes) {
+    for (const std::int32_t v : nodes_) slot_[v] = -1;
+    nodes_ = nodes;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) slot_[nodes_[i]] = static_cast<std::int32_t>(i);
+    start_.assign(nodes_.size() + 1, 0);
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (m.solid.type[e] != ElemType::Tri3) continue;
+      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+      for (int k = 0; k < 3; ++k)
+        if (const std::int32_t s = slot_[v[k].v]; s >= 0) ++start_[s + 1];
+    }
+    for (std::size_t i = 0; i < nodes_.size(); ++i) start_[i + 1] += start_[i];
+    elem_.resize(start_.back());
+    fill_.assign(start_.begin(), start_.end() - 1);
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      if (m.solid.type[e] != ElemType::Tri3) continue;
+      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+      for (int k = 0; k < 3; ++k)
+        if (const std::int32_t s = slot_[v[k].v]; s >= 0) elem_[fill_[s]++] = static_cast<std::int32_t>(e);
+    }
+  }
+  /// Requires v among the nodes of the last build.
+  std::span<const std::int32_t> of(std::int32_t v) const {
+    const std::int32_t s = slot_[v];
+    MESH_ASSERT(s >= 0, "node " << v << " not indexed");
+    return {elem_.data() + start_[s], static_cast<std::size_t>(start_[s + 1] - start_[s])};
+  }
+
+ private:
+  std::vector<std::int32_t> slot_, nodes_, start_, elem_, fill_;
+};
+
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
 int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -128,7 +173,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
   std::vector<double> angle(m.solid.size());
-  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = min_corner_angle_deg(m, e);
+  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = element_min_angle(m, e);
   auto mesh_min = [&] {
     double q = 180.0;
     for (const double a : angle) q = std::min(q, a);
@@ -162,7 +207,13 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // 45 degrees already, so flipping costs little beyond the boundary layer.
   const double good = 44.0;
   std::vector<EdgeKey> candidates;
+  std::vector<std::int32_t> lows;  // the candidates' smaller ends (distinct: keys are sorted)
+  SomeTriangles tris(n_nodes);
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
+  // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
+  // has any of its elements flipped since; its target, its elements' angles and the trial
+  // angles would be the same numbers, so it would be rejected again and is skipped.
+  std::vector<std::uint8_t> settled(n_nodes, 0);
   std::vector<std::int32_t> nb;
   std::vector<double> trial;
   for (int round = 0; round < rounds; ++round) {
@@ -179,7 +230,10 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
       // are skipped for the rest of the pass.
-      const Incidence tris(m, true);
+      lows.clear();
+      for (const EdgeKey key : candidates)
+        if (const auto lo = static_cast<std::int32_t>(key >> 32); lows.empty() || lows.back() != lo) lows.push_back(lo);
+      tris.build(m, lows);
       std::fill(touched.begin(), touched.end(), 0);
       std::size_t flips = 0;
       for (const EdgeKey key : candidates) {
@@ -211,8 +265,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
-        angle[e0] = min_corner_angle_deg(m, static_cast<std::size_t>(e0));
-        angle[e1] = min_corner_angle_deg(m, static_cast<std::size_t>(e1));
+        settled[a] = settled[b] = settled[c] = settled[d] = 0;
+        angle[e0] = element_min_angle(m, static_cast<std::size_t>(e0));
+        angle[e1] = element_min_angle(m, static_cast<std::size_t>(e1));
         ++flips;
       }
       st.flips += flips;
@@ -224,7 +279,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     for (std::size_t v = 0; v < n_nodes; ++v) {
       const bool sliding = locked[v] == 2 && slide;
       const auto elems = incident.of(static_cast<std::int32_t>(v));
-      if ((locked[v] && !sliding) || elems.empty()) continue;
+      if ((locked[v] && !sliding) || elems.empty() || settled[v]) continue;
       if (sliding) {
         nb = curve_neighbours[v];
       } else {
@@ -265,7 +320,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         bool better = true;
         for (std::size_t j = 0; j < elems.size() && better; ++j) {
           const std::size_t k = worst_first(j, worst);
-          trial[k] = min_corner_angle_deg(m, static_cast<std::size_t>(elems[k]));
+          trial[k] = element_min_angle(m, static_cast<std::size_t>(elems[k]));
           better = trial[k] > old_q + 1e-12;
         }
         if (better) {
@@ -275,9 +330,15 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
       if (moved) {
         ++st.moves;
-        for (std::size_t k = 0; k < elems.size(); ++k) angle[elems[k]] = trial[k];  // the accepted trial's
+        for (std::size_t k = 0; k < elems.size(); ++k) {
+          angle[elems[k]] = trial[k];  // the accepted trial's
+          const ElemId id{elems[k]};
+          const VertexId* ev = m.solid.nodes(id);
+          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+        }
       } else {
         m.points[v] = saved;
+        settled[v] = 1;
       }
     }
   }

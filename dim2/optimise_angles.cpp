@@ -140,10 +140,13 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
                                                              {-M_SQRT1_2, M_SQRT1_2},
                                                              {M_SQRT1_2, -M_SQRT1_2},
                                                              {-M_SQRT1_2, -M_SQRT1_2}}};
+  // settled[v]: the search from v found no better place and no node of v's elements has moved
+  // since; it would search the same numbers again and is skipped.
+  std::vector<std::uint8_t> settled(n_nodes, 0);
   for (int round = 0; round < opt.rounds; ++round) {
     std::size_t moved_this_round = 0;
     for (std::size_t v = 0; v < n_nodes; ++v) {
-      if (first[v] == first[v + 1]) continue;
+      if (first[v] == first[v + 1] || settled[v]) continue;
       const std::uint8_t lock = v < locked.size() ? locked[v] : 0;
       if (lock == 1 || (lock == 2 && !slide)) continue;
       double best_q = cached_worst(v);
@@ -183,9 +186,16 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       }
       if (best != start) {
         m.points[v] = best;  // (the caller recomputes where sliding nodes lie on the curve)
-        for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q_elem[incident[k]] = scaled_quality(incident[k]);
+        for (std::int32_t k = first[v]; k < first[v + 1]; ++k) {
+          q_elem[incident[k]] = scaled_quality(incident[k]);
+          const ElemId id{incident[k]};
+          const VertexId* ev = m.solid.nodes(id);
+          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+        }
         ++st.moves;
         ++moved_this_round;
+      } else {
+        settled[v] = 1;
       }
     }
     if (moved_this_round == 0) break;

@@ -4,10 +4,12 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "core/boundary.hpp"
 #include "core/box.hpp"
+#include "core/error.hpp"
 
 namespace febemesh::dim2 {
 
@@ -17,11 +19,33 @@ enum class NodeKind : std::uint8_t {
   Boundary = 2   ///< a projection on the curve (the paper's P points)
 };
 
+/// The nodes around an interior quadrant: its 4 corners and, 2:1 balance allowing one per
+/// edge, up to 4 hanging mid-edge nodes, stored inline (a heap vector per quadrant cost up to
+/// four allocations and ~40 bytes more each, at the run's memory peak).
+class QuadrantRing {
+ public:
+  static constexpr std::size_t capacity = 8;
+  void push_back(std::int32_t v) {
+    MESH_ASSERT(n_ < capacity, "ring of more than " << capacity << " nodes");
+    v_[n_++] = v;
+  }
+  std::size_t size() const { return n_; }
+  bool empty() const { return n_ == 0; }
+  std::int32_t operator[](std::size_t k) const { return v_[k]; }
+  const std::int32_t* begin() const { return v_.data(); }
+  const std::int32_t* end() const { return v_.data() + n_; }
+  operator std::span<const std::int32_t>() const { return {v_.data(), n_}; }
+
+ private:
+  std::array<std::int32_t, capacity> v_{};
+  std::uint8_t n_ = 0;
+};
+
 struct InteriorQuadrant {
   std::size_t leaf = 0;
   std::uint8_t level = 0;
   /// Nodes counter-clockwise from the lower-left corner, hanging mid-edge nodes included.
-  std::vector<std::int32_t> ring;
+  QuadrantRing ring;
   /// corner_slot[k]: position in `ring` of corner k of FaceCorners<2>::ring order (ll, lr, ur, ul).
   std::array<std::uint8_t, 4> corner_slot{};
   bool has_hanging() const { return ring.size() > 4; }

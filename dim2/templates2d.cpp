@@ -185,13 +185,62 @@ FeBeMesh split_to_quads(const FeBeMesh& in, const CurveMidpoint& midpoint) {
   return std::move(b.out);
 }
 
+/// Sizes of the mesh the templates make of qc (capacity reserved up front: growing the arrays
+/// by doubling held up to three times their size at the run's memory peak).
+struct TemplateCounts {
+  std::size_t elements = 0, element_nodes = 0, points = 0, lines = 0;
+};
+
+TemplateCounts count_templates(const QuadrantComplex& qc, ElementKind kind) {
+  TemplateCounts n;
+  n.points = qc.points.size();
+  auto tris = [&](std::size_t k) { n.elements += k, n.element_nodes += 3 * k; };
+  for (const InteriorQuadrant& q : qc.interior) {
+    if (q.has_hanging()) {
+      tris(q.ring.size());
+      ++n.points;
+    } else if (kind == ElementKind::Tri) {
+      tris(2);
+    } else {
+      ++n.elements, n.element_nodes += 4;
+    }
+  }
+  for (const BoundaryQuadrant& q : qc.boundary) {
+    if (q.corner >= 0) {
+      tris(q.polygon().size() - 2);
+      n.lines += 2;
+      continue;
+    }
+    if (q.is_triangle()) tris(1);
+    else if (kind == ElementKind::Tri) tris(2);
+    else ++n.elements, n.element_nodes += 4;
+    n.lines += q.node[2] != q.node[3];
+  }
+  return n;
+}
+
+void reserve(FeBeMesh& out, const TemplateCounts& n) {
+  Mesh<2>& m = out.mesh;
+  m.points.reserve(n.points);
+  out.where.reserve(n.points);
+  m.solid.type.reserve(n.elements);
+  m.solid.offset.reserve(n.elements + 1);
+  m.solid.node.reserve(n.element_nodes);
+  m.level.reserve(n.elements);
+  m.from_boundary_cell.reserve(n.elements);
+  m.interface.type.reserve(n.lines);
+  m.interface.offset.reserve(n.lines + 1);
+  m.interface.node.reserve(2 * n.lines);
+}
+
 FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint) {
   Builder b;
-  b.out.mesh.points = qc.points;
+  const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
+  reserve(b.out, count_templates(qc, base));
+  b.out.mesh.points.assign(qc.points.begin(), qc.points.end());
   b.out.where.resize(qc.points.size());
   for (std::size_t i = 0; i < qc.points.size(); ++i)
     if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where[i];
-  const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
   interior_templates(b, qc, base);
   boundary_templates(b, qc, base);
   if (kind == ElementKind::Quad) return split_to_quads(b.out, midpoint);

@@ -37,6 +37,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -255,7 +256,7 @@ bool touches(const Box<2>& view, const std::vector<P2>& poly) {
   return (b.lo.array() <= view.hi.array()).all() && (view.lo.array() <= b.hi.array()).all();
 }
 
-std::vector<P2> ring_points(const QuadrantComplex& qc, const std::vector<std::int32_t>& ids) {
+std::vector<P2> ring_points(const QuadrantComplex& qc, std::span<const std::int32_t> ids) {
   std::vector<P2> out;
   for (std::int32_t i : ids) out.push_back(qc.points[std::size_t(i)]);
   return out;
