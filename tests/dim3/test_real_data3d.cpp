@@ -10,14 +10,17 @@
 //   sphere966 L6  valid  1479648 tets, min dihedral 25.54 deg, volume error 0.04%, 44.6 s
 //   spool L4      valid    53444 tets, min dihedral  9.42 deg, volume error 17.1%,  5.9 s
 //                 (flanges thinner than 1.5 level-4 octants over 69% of the area are not meshed)
-//   spool L5      refused (inverted tets after the repairs)
 //   fandisk L4    refused: folded interface triangles across thin lips (their nodes on surface
 //                 sheets 160-170 deg apart) and ~18 inverted tets left after the untangling
 //   rotor L4      valid but 34.5% of the volume lost: 51% of the area is on blades thinner than
 //                 half a level-4 octant; refining the surface octants gives inverted tets, and
 //                 the valid coarse mesh stands
-//   anchor L4     refused: inverted tets (7 left after the untangling on the first tree); at
-//                 level 5 valid (386976 tets, 3.76 deg, 1.47%, 26.7 s: too slow for this test)
+//   anchor L4     session 5: valid through the run without the buffer rule (the run with it is
+//                 refused: rim nodes of one-octant slabs in two-octant arms project through the
+//                 arm), 242386 tets, min dihedral 8.25 deg, volume error 0.66%, 27.1 s; at
+//                 level 5 valid with the buffer (386976 tets, 3.76 deg, 1.47%, 26.7 s)
+//   spool L5      session 5: valid without the buffer rule, 394868 tets, 2.41 deg, 1.85%, 84 s
+//                 (too slow for this test)
 //   elephant L4   refused: inverted tets and folded interface triangles
 // The whole [data] run is about 76 s (45 s CPU) in Release, mostly the refused shapes' repairs.
 
