@@ -126,7 +126,9 @@ int run(const std::vector<std::string>& argv) {
                     {"elements", elements},
                     {"buffer", opt.buffer},
                     {"smoothing_iterations", opt.smoothing_iterations},
-                    {"snap_features", opt.snap_features}};
+                    {"snap_features", opt.snap_features},
+                    {"buffer_rule_dropped", r.buffer_dropped},
+                    {"feature_snapping_dropped", r.features_dropped}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},
                     {"components", surface.n_components()},

@@ -212,6 +212,7 @@ struct Projector {
 
   double min_outward = -1.0;  // BoundaryOctantOptions
   double min_facing = -1.0;
+  bool outward_all_faces = false;
 
   /// The segment from q to a surface point p (on triangle `patch`, -1 = unknown) leaves through
   /// one of q's free faces (`dirs`, bit f = face f) and lands on a side of the surface facing
@@ -232,6 +233,16 @@ struct Projector {
     const double len = d.norm();
     if (len <= 0) return true;
     const P3 np = patch >= 0 ? P3(surface.surface().normal(patch).normalized()) : P3(P3::Zero());
+    if (outward_all_faces) {
+      bool facing = min_facing <= -1.0 || patch < 0;
+      for (int f = 0; f < Cube<3>::n_faces; ++f) {
+        if (!((dirs >> f) & 1)) continue;
+        const double sign = (f % 2) ? 1.0 : -1.0;
+        if (sign * d[f / 2] / len < min_outward) return false;
+        if (sign * np[f / 2] >= min_facing) facing = true;
+      }
+      return facing;
+    }
     for (int f = 0; f < Cube<3>::n_faces; ++f) {
       if (!((dirs >> f) & 1)) continue;
       const double sign = (f % 2) ? 1.0 : -1.0;
@@ -403,7 +414,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
-  Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing};
+  Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing, opt.outward_all_faces};
   std::map<std::tuple<double, double, double>, std::int32_t> by_point;
   std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
   for (std::int32_t q = 0; q < n_lat; ++q) {
@@ -419,7 +430,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
       if (pick < cands.size()) {
         cp = cands[pick];
         ++res.stats.n_next_normal;
-      } else if (ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
+      } else if (opt.rays && ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
         ++res.stats.n_ray;
       } else if (opt.blind_closest) {
         // Keep the closest point: the untangling of the templates decides (pipeline3d).

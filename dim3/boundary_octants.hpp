@@ -111,6 +111,9 @@ struct BoundaryOctantOptions {
   /// but anchor L5 went from valid (386976 tets, 26.7 s) to refused (177 inverted, 43.8 s).
   double min_outward = -1.0;
   double min_facing = -1.0;
+  /// min_outward must hold for every free face of the node, not just one.
+  bool outward_all_faces = false;
+  bool rays = true;                  ///< try rays along the free faces' normals
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes
   double edge_radius = 0.35;         ///< project nodes within this many face sizes onto a feature line

@@ -230,7 +230,32 @@ namespace {
 Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
 }  // namespace
 
+namespace {
+Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
+}  // namespace
+
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+  if (opt.buffer <= 0 || !opt.retry_without_buffer) return mesh3d_features(s, opt, progress);
+  try {
+    return mesh3d_features(s, opt, progress);
+  } catch (const GeometryError& e) {
+    // The buffer rule drops interior octants near the surface; in a part two octants thick it
+    // leaves a slab one octant wide whose rim nodes are nearer the far sheet than their own:
+    // their projections run back through the part and fold the boundary octants on that side
+    // (measured on anchor L4, experiments/diagnose3d), and refining around them moves the
+    // folds. Without the buffer the slab reaches both sheets. Same input, same fallback.
+    if (progress) progress(std::string("without the buffer rule, after: ") + e.what());
+    Options3d plain = opt;
+    plain.buffer = 0.0;
+    Result3d r = mesh3d_features(s, plain, progress);
+    r.buffer_dropped = true;
+    return r;
+  }
+}
+
+namespace {
+
+Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   if (!opt.snap_features || s.features().n_feature_edges() == 0) return mesh3d_once(s, opt, progress);
   try {
     return mesh3d_once(s, opt, progress);
@@ -246,6 +271,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     return r;
   }
 }
+
+}  // namespace
 
 namespace {
 
@@ -312,6 +339,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
     BoundaryOctantOptions bo;
     bo.snap_features = opt.snap_features;
     bo.graze = opt.graze;
+    bo.min_outward = opt.min_outward;
+    bo.min_facing = opt.min_facing;
+    bo.outward_all_faces = opt.outward_all_faces;
+    bo.rays = opt.projection_rays;
     OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
     clock.lap("boundary octants");
     std::vector<Problem3> problems = oc.problems;

@@ -26,8 +26,15 @@ struct Options3d {
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
   bool snap_features = true;
+  /// When the run with the buffer rule fails, run once more without it (Result3d::buffer_dropped).
+  bool retry_without_buffer = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
+  /// Projection admissibility (BoundaryOctantOptions min_outward, min_facing, outward_all_faces).
+  double min_outward = -1.0;
+  double min_facing = -1.0;
+  bool outward_all_faces = false;
+  bool projection_rays = true;
   int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
   int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
   int escobar_sweeps = 100;          ///< last-resort untangling sweeps by the Escobar objective (0 = none)
@@ -59,6 +66,7 @@ struct Result3d {
   std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes
   std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
   int n_repairs = 0;
+  bool buffer_dropped = false;       ///< the run with the buffer rule failed; this one is without
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
@@ -72,7 +80,8 @@ using Progress3 = std::function<void(const std::string&)>;
 
 /// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
 /// LimitError when the tree would exceed max_cells. `s` gets the options' levels. When it fails
-/// with feature snapping it runs once more without (Result3d::features_dropped).
+/// with feature snapping it runs once more without (Result3d::features_dropped); when both fail
+/// with the buffer rule, the two once more without it (Result3d::buffer_dropped).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 }  // namespace febemesh::dim3

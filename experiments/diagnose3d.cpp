@@ -1,0 +1,197 @@
+// Experiment: why do the boundary octants of a 3D tree fold? (issue 6, `diagnose3d`)
+//
+// The pipeline's first tree for a surface at a level (subdivision, 2:1 balance, interior
+// octants with the buffer, pinch and island rules), its boundary octants by projection and the
+// raw tetrahedra from the templates, before any untangling. For every inverted tetrahedron of a
+// boundary octant we look at the octant's face nodes and their projections and sort the octant
+// by the first thing wrong with it:
+//   backward  - a node's projection runs against the octant's face normal (cos < 0): the node's
+//               closest point was chosen for another of its free faces;
+//   away      - a projection lands on surface facing away from the face (normal cos < 0): the
+//               far sheet of a part thinner than the octant, or a lip;
+//   long      - a projection longer than 1.5 face sizes;
+//   other     - all projections go out and land facing the face: shear between neighbours.
+// Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <set>
+#include <string>
+
+#include "core/local_repair.hpp"
+#include "core/orthtree.hpp"
+#include "core/quality.hpp"
+#include "core/validate.hpp"
+#include "dim3/fidelity3d.hpp"
+#include <chrono>
+#include "dim3/boundary_octants.hpp"
+#include "dim3/pipeline3d.hpp"
+#include "dim3/surface_boundary.hpp"
+#include "dim3/templates3d.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim3;
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << "usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]\n";
+    return 2;
+  }
+  const std::string path = argv[1];
+  const int level = std::atoi(argv[2]);
+  SurfaceOptions so;
+  if (argc > 3 && std::string(argv[3]).rfind("--", 0) != 0) so.thickness_cells = std::atof(argv[3]);
+  int dump = 0, only = -1;
+  bool near_on = false;
+  P3 near_p = P3::Zero();
+  double near_r = 0;
+  BoundaryOctantOptions bo;
+  bo.snap_features = false;
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--all") bo.outward_all_faces = true;
+    if (std::string(argv[i]) == "--norays") bo.rays = false;
+    if (std::string(argv[i]) == "--near" && i + 4 < argc) {
+      near_on = true;
+      near_p = P3(std::atof(argv[i + 1]), std::atof(argv[i + 2]), std::atof(argv[i + 3]));
+      near_r = std::atof(argv[i + 4]);
+    }
+    if (i + 1 >= argc) continue;
+    if (std::string(argv[i]) == "--outward") bo.min_outward = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--facing") bo.min_facing = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--dump") dump = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--only") only = std::atoi(argv[i + 1]);
+  }
+  SurfaceBoundary s = SurfaceBoundary::from_file(path, so);
+  Options3d opt;
+  opt.level = level;
+  opt.min_outward = bo.min_outward;
+  opt.min_facing = bo.min_facing;
+  opt.outward_all_faces = bo.outward_all_faces;
+  opt.projection_rays = bo.rays;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--pipeline") {
+      const auto t0 = std::chrono::steady_clock::now();
+      std::string verdict = "valid";
+      std::size_t n_tets = 0;
+      double min_dihedral = 0, vol_err = 0;
+      int repairs = 0;
+      try {
+        const Result3d r = mesh3d(s, opt, [](const std::string& m) { std::fprintf(stderr, "  %s\n", m.c_str()); });
+        ValidateOptions<3> vo;
+        if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
+        vo.boundary_distance = [&](const Point<3>& p) { return s.closest_point(p).distance; };
+        vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
+        const ValidationReport v = validate(r.fe.mesh, vo);
+        if (!v.valid) verdict = "INVALID " + v.summary();
+        n_tets = r.fe.mesh.solid.size();
+        min_dihedral = summarize_quality(r.fe.mesh).min_angle_deg;
+        vol_err = measure_fidelity(r.fe.mesh, s, 1).volume_rel_error;
+        repairs = r.n_repairs;
+      } catch (const std::exception& e) {
+        verdict = std::string("refused: ") + e.what();
+        if (verdict.size() > 300) verdict.resize(300);
+      }
+      const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      std::printf("PIPELINE %s L%d: %s, %zu tets, min dihedral %.2f deg, volume error %.2f%%, %d repairs, %.1f s\n",
+                  path.c_str(), level, verdict.c_str(), n_tets, min_dihedral, 100 * vol_err, repairs, sec);
+      return 0;
+    }
+  s.set_global_level(opt.level);
+  s.set_max_level(opt.level + opt.extra_levels);
+  RefineOptions ro;
+  ro.max_level = opt.level + opt.extra_levels + 2;
+  const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
+  Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
+  const std::vector<Side> sides = classify(tree, s);
+  Flags in = interior_flags(sides);
+  const std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
+  const std::size_t np = remove_pinches(tree, in);
+  const std::size_t ni = keep_largest_components(tree, in, s.n_components());
+  std::size_t n_in = 0;
+  for (auto f : in) n_in += f;
+  std::printf("%s level %d thickness_cells %.2f: %zu leaves, %zu interior (buffer %zu, pinch %zu, islands %zu)\n",
+              path.c_str(), level, so.thickness_cells, tree.n_leaves(), n_in, nb, np, ni);
+  const OctantComplexResult ocr = build_octant_complex(tree, in, s, bo);
+  const OctantComplex& oc = ocr.complex;
+  std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu\n", ocr.stats.n_free_faces,
+              ocr.stats.n_surface_nodes, ocr.stats.n_next_normal, ocr.stats.n_ray, ocr.stats.n_blind);
+  const SurfacePointFn sp = [&](const P3& p) {
+    const ClosestPoint<3> cp = s.closest_point(p);
+    return std::make_pair(P3(cp.point), cp.where);
+  };
+  const TetMesh fe = tetrahedralize(tree, oc, sp);
+  const std::int32_t n_interior = static_cast<std::int32_t>(oc.interior.size());
+  std::set<std::int32_t> bad_octants;
+  std::size_t n_bad = 0, n_bad_interior = 0;
+  for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+    const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
+             &d = fe.mesh.points[v[3].v];
+    if ((b - a).dot((c - a).cross(d - a)) > 0) continue;
+    ++n_bad;
+    if (fe.cell[e] < n_interior) ++n_bad_interior;
+    else bad_octants.insert(fe.cell[e] - n_interior);
+  }
+  const auto classify_octant = [&](std::size_t k, bool print) {
+    const BoundaryOctant& b = oc.boundary[k];
+    P3 nf = P3::Zero();
+    nf[b.face / 2] = (b.face % 2) ? 1.0 : -1.0;
+    const double h = length(b.cell) * tree.unit();
+    int why = 3;
+    for (std::int32_t q : b.ring) {
+      const std::int32_t p = oc.projection[q];
+      const P3 dq = oc.points[p] - oc.points[q];
+      const double len = dq.norm();
+      const double cos_d = len > 0 ? dq.dot(nf) / len : 1.0;
+      const P3 ns = s.surface().normal(oc.where[p].patch).normalized();
+      const double cos_n = ns.dot(nf);
+      int w = 3;
+      if (cos_d < 0) w = 0;
+      else if (cos_n < 0) w = 1;
+      else if (len > 1.5 * h) w = 2;
+      why = std::min(why, w);
+      if (print)
+        std::printf("    node %d at (%.4f %.4f %.4f) -> (%.4f %.4f %.4f) tri %d: |d|/h %.2f cos(d,nf) %.2f cos(ns,nf) %.2f\n",
+                    q, oc.points[q][0], oc.points[q][1], oc.points[q][2], oc.points[p][0], oc.points[p][1],
+                    oc.points[p][2], oc.where[p].patch, len / h, cos_d, cos_n);
+    }
+    return why;
+  };
+  const char* names[] = {"backward", "away", "long", "other"};
+  std::map<int, int> count_bad, count_all;
+  for (std::size_t k = 0; k < oc.boundary.size(); ++k) ++count_all[classify_octant(k, false)];
+  int shown = 0;
+  for (std::int32_t k : bad_octants) {
+    const int w = classify_octant(k, false);
+    ++count_bad[w];
+    bool close = true;
+    if (near_on) {
+      close = false;
+      for (std::int32_t q : oc.boundary[k].ring) close = close || (oc.points[q] - near_p).norm() < near_r;
+    }
+    if (shown < dump && (only < 0 || only == w) && close) {
+      const BoundaryOctant& b = oc.boundary[k];
+      const double h0 = length(b.cell) * tree.unit();
+      std::printf("  octant %d (%s): leaf level %d face %d h %.4f\n", k, names[w], b.cell.level, b.face,
+                  length(b.cell) * tree.unit());
+      classify_octant(k, true);
+      for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+        if (fe.cell[e] != n_interior + k) continue;
+        const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+        const P3 &a = fe.mesh.points[v[0].v], &b2 = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
+                 &d = fe.mesh.points[v[3].v];
+        const double vol = (b2 - a).dot((c - a).cross(d - a)) / 6.0;
+        if (vol <= 0) std::printf("    tet %d %d %d %d vol/h^3 %.3g\n", v[0].v, v[1].v, v[2].v, v[3].v, vol / (h0 * h0 * h0));
+      }
+      ++shown;
+    }
+  }
+  std::printf("raw inverted tets %zu (interior cells %zu) in %zu boundary octants of %zu\n", n_bad, n_bad_interior,
+              bad_octants.size(), oc.boundary.size());
+  for (int w = 0; w < 4; ++w)
+    std::printf("  %-8s folded octants %5d   all octants %6d\n", names[w], count_bad[w], count_all[w]);
+  return 0;
+}
