@@ -119,21 +119,32 @@ TEST_CASE("pipeline is deterministic and its MSH reads back the same", "[propert
 
 TEST_CASE("the FE area approaches the exact area as the level rises", "[property][pipeline2d]") {
   Tally tally;
-  test::prop("area error at level L+2 below that at L", 4, [&] {
+  test::prop("BE distance to the curve falls over two levels and bounds the area error", 4, [&] {
     PipelineCase c = *test::gen_pipeline_case(ElementKind::Tri);
     RC_PRE(c.domain.level <= 7);  // three levels up to 9 keep the CI budget
-    std::vector<double> err;
+    double perimeter = 0.0;
+    {
+      const CurveBoundary curve(test::to_domain(c.domain));
+      for (std::size_t l = 0; l < curve.loops().size(); ++l) perimeter += curve.length(int(l));
+    }
+    std::vector<double> err, haus;
     for (int k = 0; k < 3; ++k) {
       const test::PipelineOutcome out = run_case(c, tally);
       RC_ASSERT(out.v.valid);
       err.push_back(out.f.area_rel_error);
+      haus.push_back(out.f.hausdorff);
+      // The region between the BE polygon and the curve lies within the Hausdorff distance of
+      // the curve: |FE area - exact area| <= perimeter x Hausdorff (1% margin for sampling).
+      RC_ASSERT(out.f.area_rel_error * out.f.exact_area <= 1.01 * perimeter * out.f.hausdorff);
       ++c.domain.level;
     }
-    RC_LOG() << "area errors " << err[0] << " " << err[1] << " " << err[2] << "\n";
-    // The file's own levels can fix the finest cells and the quality pass slides boundary nodes,
-    // so halving is not guaranteed on every domain (CI found 2.3e-5, 1.6e-5, 1.5e-5); a decrease
-    // over two levels is. Second order on a smooth loop is tested in test_pipeline2d.cpp.
-    RC_ASSERT(err[2] < std::max(err[0], err[1]));
+    RC_LOG() << "area errors " << err[0] << " " << err[1] << " " << err[2] << ", Hausdorff " << haus[0] << " "
+             << haus[1] << " " << haus[2] << "\n";
+    // The signed area error is not monotone (chords inside convex parts and outside concave ones
+    // cancel: 777006 found 2.6e-6, 3.9e-6, 5.3e-6 at levels 6-8), and the file's own levels can
+    // fix the finest cells; two more levels still halve the cells everywhere, so the distance
+    // that bounds it falls.
+    RC_ASSERT(haus[2] < haus[0]);
   });
   tally.print("area convergence");
 }
