@@ -1,11 +1,13 @@
 // `febemesh mesh3d SURFACE -o DIR`: the octree pipeline (dim3/pipeline3d.hpp) on a closed
 // triangle surface, validated, written atomically as mesh.msh, mesh.vtu and report.json.
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
@@ -43,6 +45,8 @@ const char* help_text =
     "                      (0..0.5, default 0.2)\n"
     "  --smooth N          smoothing iterations (0..50, default 4)\n"
     "  --no-features       do not snap to feature edges and corners\n"
+    "  --threads N         threads for refinement and classification (default: all cores);\n"
+    "                      the mesh is the same for every N\n"
     "  --allow-invalid     write the mesh even if validation fails (exit status 1 still)\n"
     "  --quiet             no progress on stderr\n\n"
     "Bad input (open, non-manifold or self-intersecting surface, unreadable file) exits with\n"
@@ -79,7 +83,7 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--allow-invalid"},
-                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth"});
+                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -90,6 +94,8 @@ int run(const std::vector<std::string>& argv) {
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
   opt.snap_features = !args.has("--no-features");
+  const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
   opt.hex_dominant = elements == "hex";
   const bool quiet = args.has("--quiet");
@@ -127,6 +133,7 @@ int run(const std::vector<std::string>& argv) {
                     {"buffer", opt.buffer},
                     {"smoothing_iterations", opt.smoothing_iterations},
                     {"snap_features", opt.snap_features},
+                    {"threads", opt.n_threads},
                     {"buffer_rule_dropped", r.buffer_dropped},
                     {"feature_snapping_dropped", r.features_dropped}};
   rep["surface"] = {{"triangles", surface.triangles().size()},

@@ -1,0 +1,42 @@
+// `febemesh mesh3d --threads`: the same mesh for every thread count; out-of-range counts are
+// bad usage.
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace {
+
+int run_status(const std::string& args) {
+  const std::string cmd = std::string("'") + FEBEMESH_CLI + "' " + args + " >/dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
+  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_" + std::to_string(::getpid()));
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  for (const char* n : {"1", "2"})
+    REQUIRE(run_status("mesh3d '" + sphere + "' -o '" + (dir / n).string() + "' --level 4 --quiet --threads " + n) == 0);
+  const std::string one = read_text(dir / "1" / "mesh.msh"), two = read_text(dir / "2" / "mesh.msh");
+  CHECK(one.size() > 1000);
+  CHECK(one == two);
+  CHECK(nlohmann::json::parse(read_text(dir / "2" / "report.json"))["options"]["threads"] == 2);
+  CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --threads 0") == 2);
+  CHECK(!std::filesystem::exists(dir / "0"));
+  std::filesystem::remove_all(dir);
+}
