@@ -38,7 +38,7 @@ struct AngleOptimiseOptions {
 
 struct AngleOptimiseStats {
   std::size_t moves = 0;
-  double worst_before = 0.0;  ///< smallest q over the mesh
+  double worst_before = 0.0;  ///< smallest q over the mesh (triangles scaled by target / triangle_target when set)
   double worst_after = 0.0;
 };
 
