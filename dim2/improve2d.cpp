@@ -169,6 +169,20 @@ int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
 // edge flipped, candidate edges are those of elements below `good`, and adjacency is CSR built
 // once per pass; the visiting order (edges by key, nodes by index) is the plain algorithm's, so
 // the result is the same as recomputing everything.
+std::vector<std::vector<std::int32_t>> interface_neighbours(const Mesh<2>& m) {
+  std::vector<std::vector<std::int32_t>> nbr(m.points.size());
+  for (std::size_t e = 0; e < m.interface.size(); ++e) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    nbr[v[0].v].push_back(v[1].v);
+    nbr[v[1].v].push_back(v[0].v);
+  }
+  for (auto& nb : nbr) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  return nbr;
+}
+
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
@@ -192,16 +206,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     interface_edge.push_back(key_of(v[0].v, v[1].v));
   }
   std::sort(interface_edge.begin(), interface_edge.end());
-  std::vector<std::vector<std::int32_t>> curve_neighbours(n_nodes);
-  for (std::size_t e = 0; e < m.interface.size(); ++e) {
-    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
-    curve_neighbours[v[0].v].push_back(v[1].v);
-    curve_neighbours[v[1].v].push_back(v[0].v);
-  }
-  for (auto& nb : curve_neighbours) {
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-  }
+  const std::vector<std::vector<std::int32_t>> curve_neighbours = interface_neighbours(m);
 
   // Flips are tried only on edges of elements below `good` degrees: the interior templates have
   // 45 degrees already, so flipping costs little beyond the boundary layer.

@@ -33,6 +33,10 @@ double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e);
 /// position when it must not move there (e.g. onto another loop).
 using SlideFn = std::function<Point<2>(std::int32_t v, const Point<2>& target)>;
 
+/// Each node's neighbours along the BE mesh (the other ends of its interface elements),
+/// ascending, without repeats; empty for nodes off the interface.
+std::vector<std::vector<std::int32_t>> interface_neighbours(const Mesh<2>& m);
+
 /// `locked[v]`: 0 free, 1 never moves (corners), 2 interface node that may slide along the curve
 /// through `slide` (toward the midpoint of its two interface neighbours); without `slide`,
 /// 2 is the same as 1.

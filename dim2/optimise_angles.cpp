@@ -80,23 +80,13 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     return m.solid.type[e] == ElemType::Tri3 && q > 0 ? q * triangle_scale : q;
   };
 
-  // The two BE chord neighbours of each interface node (-1: none), for the chord bound.
-  std::vector<std::array<std::int32_t, 2>> chord_nbr;
-  if (opt.curve_distance) {
-    chord_nbr.assign(n_nodes, {-1, -1});
-    for (std::size_t s = 0; s < m.interface.size(); ++s) {
-      const VertexId* ab = m.interface.nodes(ElemId{static_cast<std::int32_t>(s)});
-      for (int j = 0; j < 2; ++j) {
-        auto& slot = chord_nbr[ab[j].v];
-        (slot[0] < 0 ? slot[0] : slot[1]) = ab[1 - j].v;
-      }
-    }
-  }
-  // How far v's two chords stray from the curve with v at p (their midpoints' distance).
+  // The BE chord neighbours of each interface node, for the chord bound.
+  const std::vector<std::vector<std::int32_t>> chord_nbr =
+      opt.curve_distance ? interface_neighbours(m) : std::vector<std::vector<std::int32_t>>();
+  // How far v's chords stray from the curve with v at p (their midpoints' distance).
   auto chord_deviation = [&](std::size_t v, const P2& p) {
     double d = 0.0;
-    for (const std::int32_t u : chord_nbr[v])
-      if (u >= 0) d = std::max(d, opt.curve_distance(0.5 * (p + m.points[u])));
+    for (const std::int32_t u : chord_nbr[v]) d = std::max(d, opt.curve_distance(0.5 * (p + m.points[u])));
     return d;
   };
 
