@@ -224,55 +224,48 @@ void add_problems(const Mesh<3>& m, const std::vector<std::size_t>& bad, const s
   for (std::size_t f : folded) out.push_back({face_centroid(m, f), "the surface mesh folds" + when});
 }
 
-}  // namespace
-
-namespace {
 Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
-}  // namespace
 
-namespace {
-Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
+/// run(opt), and when that throws GeometryError, once more with `fallback` (the same input and
+/// the same fallback, so still deterministic), reporting why and setting `dropped`.
+template <typename Run>
+Result3d with_fallback(const Run& run, const Options3d& opt, const Options3d& fallback, const std::string& what,
+                       bool Result3d::*dropped, const Progress3& progress) {
+  try {
+    return run(opt);
+  } catch (const GeometryError& e) {
+    if (progress) progress("without " + what + ", after: " + e.what());
+    Result3d r = run(fallback);
+    r.*dropped = true;
+    return r;
+  }
+}
+
+Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+  const auto once = [&](const Options3d& o) { return mesh3d_once(s, o, progress); };
+  if (!opt.snap_features || s.features().n_feature_edges() == 0) return once(opt);
+  // Feature snapping pulls nodes across octants; on coarsely faceted surfaces (every edge a
+  // feature: tori of 8 segments) it leaves tetrahedra no node move can unfold, where the plain
+  // projection meshes validly.
+  Options3d plain = opt;
+  plain.snap_features = false;
+  return with_fallback(once, opt, plain, "feature snapping", &Result3d::features_dropped, progress);
+}
+
 }  // namespace
 
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  if (opt.buffer <= 0 || !opt.retry_without_buffer) return mesh3d_features(s, opt, progress);
-  try {
-    return mesh3d_features(s, opt, progress);
-  } catch (const GeometryError& e) {
-    // The buffer rule drops interior octants near the surface; in a part two octants thick it
-    // leaves a slab one octant wide whose rim nodes are nearer the far sheet than their own:
-    // their projections run back through the part and fold the boundary octants on that side
-    // (measured on anchor L4, experiments/diagnose3d), and refining around them moves the
-    // folds. Without the buffer the slab reaches both sheets. Same input, same fallback.
-    if (progress) progress(std::string("without the buffer rule, after: ") + e.what());
-    Options3d plain = opt;
-    plain.buffer = 0.0;
-    Result3d r = mesh3d_features(s, plain, progress);
-    r.buffer_dropped = true;
-    return r;
-  }
+  const auto features = [&](const Options3d& o) { return mesh3d_features(s, o, progress); };
+  if (opt.buffer <= 0 || !opt.retry_without_buffer) return features(opt);
+  // The buffer rule drops interior octants near the surface; in a part two octants thick it
+  // leaves a slab one octant wide whose rim nodes are nearer the far sheet than their own:
+  // their projections run back through the part and fold the boundary octants on that side
+  // (measured on anchor L4, experiments/diagnose3d), and refining around them moves the
+  // folds. Without the buffer the slab reaches both sheets.
+  Options3d plain = opt;
+  plain.buffer = 0.0;
+  return with_fallback(features, opt, plain, "the buffer rule", &Result3d::buffer_dropped, progress);
 }
-
-namespace {
-
-Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  if (!opt.snap_features || s.features().n_feature_edges() == 0) return mesh3d_once(s, opt, progress);
-  try {
-    return mesh3d_once(s, opt, progress);
-  } catch (const GeometryError& e) {
-    // Feature snapping pulls nodes across octants; on coarsely faceted surfaces (every edge a
-    // feature: tori of 8 segments) it leaves tetrahedra no node move can unfold, where the plain
-    // projection meshes validly. Same input, same fallback: still deterministic.
-    if (progress) progress(std::string("without feature snapping, after: ") + e.what());
-    Options3d plain = opt;
-    plain.snap_features = false;
-    Result3d r = mesh3d_once(s, plain, progress);
-    r.features_dropped = true;
-    return r;
-  }
-}
-
-}  // namespace
 
 namespace {
 
