@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/error.hpp"
+#include "core/lattice_nodes.hpp"
 #include "core/orthtree.hpp"
 
 namespace febemesh {
@@ -45,8 +46,8 @@ void radix_sort(std::vector<std::uint64_t>& keys) {
   radix_sort(keys.data(), keys.data() + keys.size(), shift);
 }
 
-/// std::lower_bound(keys, key) as an index, found by galloping outward from `hint`: the same
-/// answer in O(log distance) steps (the corners of consecutive leaves lie close in Morton order).
+}  // namespace
+
 std::size_t lower_bound_from(const std::vector<std::uint64_t>& keys, std::uint64_t key, std::size_t hint) {
   const std::size_t n = keys.size();
   hint = std::min(hint, n);
@@ -82,7 +83,6 @@ std::size_t lower_bound_from(const std::vector<std::uint64_t>& keys, std::uint64
                                   keys.begin());
 }
 
-}  // namespace
 
 template <int Dim> std::int32_t LatticeNodes<Dim>::find(const LatticePoint<Dim>& p) const {
   const std::uint64_t key = point_key<Dim>(p);

@@ -1,6 +1,7 @@
 #include "dim2/boundary_quadrants.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
 #include "core/free_facets.hpp"
+#include "core/lattice_nodes.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -207,8 +209,12 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     return it != node_keys.end() && *it == key ? std::int32_t(it - node_keys.begin()) : std::int32_t(-1);
   };
 
-  // Interior quadrants: CCW rings with hanging mid-edge nodes.
+  // Interior quadrants: CCW rings with hanging mid-edge nodes. Corners are the lattice nodes'
+  // own answer (leaf_corners); a mid-edge node is searched by galloping from the same edge's
+  // answer for the previous quadrant (consecutive leaves are near in Morton order): the index
+  // a full binary search gives, in a few probes of nearby keys.
   qc.interior.reserve(static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
+  std::array<std::size_t, 4> near{};
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!in[i]) continue;
     const Cell<2>& c = t.leaf(i);
@@ -216,12 +222,13 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     q.leaf = i;
     q.level = c.level;
     for (int k = 0; k < 4; ++k) {
-      const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
       q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
-      q.ring.push_back(find_node(a));
+      q.ring.push_back(nodes.leaf_corners[i][FaceCorners<2>::ring[k]]);
       if (length(c) >= 2) {
-        const std::int32_t m = find_node(midpoint(a, b));
-        if (m >= 0) q.ring.push_back(m);
+        const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
+        const std::uint64_t key = point_key<2>(midpoint(a, b));
+        near[k] = lower_bound_from(node_keys, key, near[k]);
+        if (near[k] < node_keys.size() && node_keys[near[k]] == key) q.ring.push_back(static_cast<std::int32_t>(near[k]));
       }
     }
     qc.interior.push_back(std::move(q));
