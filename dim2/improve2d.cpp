@@ -76,6 +76,51 @@ inline double element_min_angle(const Mesh<2>& m, std::size_t e) {
   return polygon_min_angle_n<4>(p);
 }
 
+/// The largest corner cotangent of polygon pts (CCW): the smallest angle falls as it rises.
+/// +inf when polygon_min_angle_n gives -1 (a corner turns the wrong way), NaN when only
+/// polygon_min_angle_n can tell (a flat corner, non-finite coordinates).
+template <int n> double polygon_top_cot(const P2* pts) {
+  double top = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < n; ++k) {
+    const P2 &prev = pts[(k + n - 1) % n], &cur = pts[k], &next = pts[(k + 1) % n];
+    if (cross(prev, cur, next) <= 0) return std::numeric_limits<double>::infinity();
+    const P2 a = prev - cur, b = next - cur;
+    const double cr = std::abs(a[0] * b[1] - a[1] * b[0]), dot = a.dot(b);
+    if (!(cr > 0) || !std::isfinite(dot)) return std::numeric_limits<double>::quiet_NaN();
+    top = std::max(top, dot / cr);
+  }
+  return top;
+}
+
+inline double element_top_cot(const Mesh<2>& m, std::size_t e) {
+  const VertexId* v = m.solid.node.data() + m.solid.offset[e];
+  if (m.solid.offset[e + 1] - m.solid.offset[e] == 3) {
+    const P2 p[3] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v]};
+    return polygon_top_cot<3>(p);
+  }
+  const P2 p[4] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]};
+  return polygon_top_cot<4>(p);
+}
+
+/// Whether angle a exceeds angle b + eps (degrees, 0 <= eps <= 1e-6), where ca and cb are the
+/// angles' cotangents (as polygon_top_cot gives them) and exact_a / exact_b their degrees as
+/// polygon_min_angle_n gives them. The angle acot(c) falls by at least dc / (1 + c^2) over
+/// [c, c + dc], so cotangents further apart than (eps in radians + 1e-11) (1 + c^2) decide as
+/// the degrees would: the degrees agree with acot of the cotangent to ~1e-15 rad (one rounding
+/// in the quotient, atan2's own error, and the element's smallest angle is that of its largest
+/// cotangent up to those), and a smallest angle over elements whose cotangents lie within
+/// 2e-12 (1 + c^2) of the largest (a tie, see improve_mesh) lies within 2e-12 rad of acot of it:
+/// both far inside 1e-11. Closer ones, and non-finite ones, are decided on
+/// the exact degrees, which are computed only then (atan2 is most of an angle's cost).
+template <class A, class B> bool exceeds(double ca, A&& exact_a, double cb, B&& exact_b, double eps) {
+  if (std::isfinite(ca) && std::isfinite(cb)) {
+    const double band = (eps * (M_PI / 180.0) + 1e-11) * (1.0 + std::max(ca * ca, cb * cb));
+    if (cb - ca > band) return true;
+    if (ca - cb > band) return false;
+  }
+  return exact_a() > exact_b() + eps;
+}
+
 }  // namespace
 
 double min_corner_angle_deg(const Mesh<2>& m, std::size_t e) { return element_min_angle(m, e); }
@@ -186,11 +231,26 @@ std::vector<std::vector<std::int32_t>> interface_neighbours(const Mesh<2>& m) {
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
-  std::vector<double> angle(m.solid.size());
-  for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = element_min_angle(m, e);
+  constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
+  // Each element's smallest angle as its largest corner cotangent (cot) with the exact degrees
+  // (deg, element_min_angle bit for bit) computed the first time a comparison needs them; every
+  // decision below is the one the degrees make (exceeds).
+  std::vector<double> cot(m.solid.size()), deg(m.solid.size(), unknown);
+  for (std::size_t e = 0; e < m.solid.size(); ++e) cot[e] = element_top_cot(m, e);
+  auto exact = [&](std::size_t e) {
+    if (std::isnan(deg[e])) deg[e] = element_min_angle(m, e);
+    return deg[e];
+  };
+  // The smallest degrees over the mesh: only elements within rounding of the largest
+  // cotangent (or without a finite one) can hold it.
   auto mesh_min = [&] {
+    double top = -std::numeric_limits<double>::infinity();
+    for (const double c : cot)
+      if (std::isfinite(c)) top = std::max(top, c);
+    const double band = 1e-12 * (1.0 + top * top);
     double q = 180.0;
-    for (const double a : angle) q = std::min(q, a);
+    for (std::size_t e = 0; e < cot.size(); ++e)
+      if (!std::isfinite(cot[e]) || !(top - cot[e] > band)) q = std::min(q, exact(e));
     return q;
   };
   st.min_angle_before = mesh_min();
@@ -210,7 +270,10 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
 
   // Flips are tried only on edges of elements below `good` degrees: the interior templates have
   // 45 degrees already, so flipping costs little beyond the boundary layer.
-  const double good = 44.0;
+  const double good = 44.0, good_cot = 1.0 / std::tan(good * M_PI / 180.0);
+  auto is_good = [&](std::size_t e) {  // exact(e) >= good
+    return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact(e); }, 0.0);
+  };
   std::vector<EdgeKey> candidates;
   std::vector<std::int32_t> lows;  // the candidates' smaller ends (distinct: keys are sorted)
   SomeTriangles tris(n_nodes);
@@ -220,13 +283,13 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // angles would be the same numbers, so it would be rejected again and is skipped.
   std::vector<std::uint8_t> settled(n_nodes, 0);
   std::vector<std::int32_t> nb;
-  std::vector<double> trial;
+  std::vector<double> trial_cot, trial_deg;
   for (int round = 0; round < rounds; ++round) {
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
       candidates.clear();
       for (std::size_t e = 0; e < m.solid.size(); ++e) {
-        if (m.solid.type[e] != ElemType::Tri3 || angle[e] >= good) continue;
+        if (m.solid.type[e] != ElemType::Tri3 || is_good(e)) continue;
         const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
         for (int k = 0; k < 3; ++k) candidates.push_back(key_of(v[k].v, v[(k + 1) % 3].v));
       }
@@ -252,7 +315,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         }
         if (n_pair != 2) continue;  // a boundary edge, or (never in a valid mesh) an edge of 3+ triangles
         const std::int32_t e0 = std::min(pair[0], pair[1]), e1 = std::max(pair[0], pair[1]);
-        if (angle[e0] >= good && angle[e1] >= good) continue;
+        if (is_good(static_cast<std::size_t>(e0)) && is_good(static_cast<std::size_t>(e1))) continue;
         if (std::binary_search(interface_edge.begin(), interface_edge.end(), key)) continue;
         if (touched[e0] || touched[e1]) continue;
         VertexId* v0 = m.solid.node.data() + m.solid.offset[e0];
@@ -263,16 +326,24 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         const std::int32_t d = v1[(k1 + 2) % 3].v;
         if (v1[k1].v != b || v1[(k1 + 1) % 3].v != a) continue;  // not opposite orientation
         const P2 &pa = m.points[a], &pb = m.points[b], &pc = m.points[c], &pd = m.points[d];
-        const double before = std::min(tri_min_angle(pa, pb, pc), tri_min_angle(pb, pa, pd));
-        const double after = std::min(tri_min_angle(pc, pa, pd), tri_min_angle(pd, pb, pc));
-        if (after <= before + 1e-9) continue;
+        // before = min(t[0], t[1]) now, after = min(t[2], t[3]) flipped; flip iff
+        // after > before + 1e-9, i.e. each of t[2], t[3] exceeds t[0] or t[1] by 1e-9.
+        const std::array<std::array<P2, 3>, 4> t = {{{pa, pb, pc}, {pb, pa, pd}, {pc, pa, pd}, {pd, pb, pc}}};
+        std::array<double, 4> tc, td;
+        for (int i = 0; i < 4; ++i) tc[i] = polygon_top_cot<3>(t[i].data()), td[i] = unknown;
+        auto tri_deg = [&](int i) {
+          if (std::isnan(td[i])) td[i] = polygon_min_angle_n<3>(t[i].data());
+          return td[i];
+        };
+        auto beats = [&](int i, int j) { return exceeds(tc[i], [&] { return tri_deg(i); }, tc[j], [&] { return tri_deg(j); }, 1e-9); };
+        if (!((beats(2, 0) || beats(2, 1)) && (beats(3, 0) || beats(3, 1)))) continue;
         // New triangles (c, a, d) and (d, b, c): both positive since after > before >= -1.
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
-        angle[e0] = element_min_angle(m, static_cast<std::size_t>(e0));
-        angle[e1] = element_min_angle(m, static_cast<std::size_t>(e1));
+        cot[e0] = tc[2], deg[e0] = td[2];
+        cot[e1] = tc[3], deg[e1] = td[3];
         ++flips;
       }
       st.flips += flips;
@@ -306,15 +377,41 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       P2 target = P2::Zero();
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
-      double old_q = 180.0;
+      // old_q, the smallest angle of v's elements, by cotangent: elems[worst] holds it. Its
+      // exact degrees are computed only if a comparison needs them, as the smallest over all
+      // of v's elements when another one is within rounding of it (a tie: the degrees may
+      // order them otherwise) or one has no finite cotangent (then old_cot is NaN: exact only).
       std::size_t worst = 0;
-      for (std::size_t k = 0; k < elems.size(); ++k) {
-        if (angle[elems[k]] < old_q) worst = k;
-        old_q = std::min(old_q, angle[elems[k]]);
+      bool all_finite = std::isfinite(cot[elems[0]]);
+      for (std::size_t k = 1; k < elems.size(); ++k) {
+        all_finite = all_finite && std::isfinite(cot[elems[k]]);
+        if (cot[elems[k]] > cot[elems[worst]]) worst = k;
       }
+      const double old_cot = all_finite ? cot[elems[worst]] : unknown;
+      bool tie = false;
+      if (all_finite) {
+        const double band = 2e-12 * (1.0 + old_cot * old_cot);
+        for (std::size_t k = 0; k < elems.size() && !tie; ++k) tie = k != worst && !(old_cot - cot[elems[k]] > band);
+      }
+      double old_deg = unknown;
       const P2 saved = m.points[v];
+      auto old_exact = [&] {
+        if (std::isnan(old_deg)) {
+          const P2 tried = m.points[v];
+          m.points[v] = saved;
+          if (tie || !all_finite) {
+            old_deg = 180.0;
+            for (const std::int32_t e : elems) old_deg = std::min(old_deg, exact(static_cast<std::size_t>(e)));
+          } else {
+            old_deg = exact(static_cast<std::size_t>(elems[worst]));
+          }
+          m.points[v] = tried;
+        }
+        return old_deg;
+      };
       bool moved = false;
-      trial.resize(elems.size());
+      trial_cot.resize(elems.size());
+      trial_deg.resize(elems.size());
       for (double step : {1.0, 0.5, 0.25}) {
         m.points[v] = saved + step * (target - saved);
         if (sliding) m.points[v] = slide(static_cast<std::int32_t>(v), m.points[v]);
@@ -325,8 +422,14 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         bool better = true;
         for (std::size_t j = 0; j < elems.size() && better; ++j) {
           const std::size_t k = worst_first(j, worst);
-          trial[k] = element_min_angle(m, static_cast<std::size_t>(elems[k]));
-          better = trial[k] > old_q + 1e-12;
+          const auto e = static_cast<std::size_t>(elems[k]);
+          trial_cot[k] = element_top_cot(m, e);
+          trial_deg[k] = unknown;
+          auto trial_exact = [&] {
+            if (std::isnan(trial_deg[k])) trial_deg[k] = element_min_angle(m, e);
+            return trial_deg[k];
+          };
+          better = exceeds(trial_cot[k], trial_exact, old_cot, old_exact, 1e-12);
         }
         if (better) {
           moved = true;
@@ -336,7 +439,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       if (moved) {
         ++st.moves;
         for (std::size_t k = 0; k < elems.size(); ++k) {
-          angle[elems[k]] = trial[k];  // the accepted trial's
+          cot[elems[k]] = trial_cot[k];  // the accepted trial's
+          deg[elems[k]] = trial_deg[k];
           const ElemId id{elems[k]};
           const VertexId* ev = m.solid.nodes(id);
           for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
