@@ -14,43 +14,82 @@ std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> FreeFacet<Dim>::corners
   return out;
 }
 
-template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep) {
-  std::vector<FreeFacet<Dim>> out;
-  const LeafKeys<Dim> keys(t);
-  std::vector<std::size_t> nb;
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
-    if (!keep[i]) continue;
-    const Cell<Dim>& c = t.leaf(i);
-    for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
-      keys.face_neighbours(i, f, nb);
-      if (nb.empty()) {
-        out.push_back({i, f, c});
-        continue;
-      }
-      const bool finer = t.leaf(nb[0]).level > c.level;
-      if (!finer) {
-        if (!keep[nb[0]]) out.push_back({i, f, c});
-        continue;
-      }
-      // Finer side: if none of them is kept, the whole facet is free (its sub-facet corners
-      // would not be nodes); otherwise each unkept finer neighbour gives a free sub-facet.
-      const bool any_kept = std::any_of(nb.begin(), nb.end(), [&](std::size_t n) { return keep[n] != 0; });
-      if (!any_kept) {
-        out.push_back({i, f, c});
-        continue;
-      }
-      for (std::size_t n : nb) {
-        if (keep[n]) continue;
-        Cell<Dim> mirror;
-        // The finer neighbour's mirror inside `c` across facet f (opposite facet of the neighbour).
-        const bool ok = face_neighbour(t.leaf(n), f ^ 1, mirror);
-        MESH_ASSERT(ok, "finer neighbour has no mirror inside its coarser neighbour");
-        (void)ok;
-        out.push_back({i, f, mirror});
-      }
+namespace {
+
+/// Appends the free facets of kept leaf i, in facet order.
+template <int Dim>
+void leaf_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep, std::size_t i,
+                      std::vector<std::size_t>& nb, std::vector<FreeFacet<Dim>>& out) {
+  const Cell<Dim>& c = t.leaf(i);
+  for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+    keys.face_neighbours(i, f, nb);
+    if (nb.empty()) {
+      out.push_back({i, f, c});
+      continue;
+    }
+    const bool finer = t.leaf(nb[0]).level > c.level;
+    if (!finer) {
+      if (!keep[nb[0]]) out.push_back({i, f, c});
+      continue;
+    }
+    // Finer side: if none of them is kept, the whole facet is free (its sub-facet corners
+    // would not be nodes); otherwise each unkept finer neighbour gives a free sub-facet.
+    const bool any_kept = std::any_of(nb.begin(), nb.end(), [&](std::size_t n) { return keep[n] != 0; });
+    if (!any_kept) {
+      out.push_back({i, f, c});
+      continue;
+    }
+    for (std::size_t n : nb) {
+      if (keep[n]) continue;
+      Cell<Dim> mirror;
+      // The finer neighbour's mirror inside `c` across facet f (opposite facet of the neighbour).
+      const bool ok = face_neighbour(t.leaf(n), f ^ 1, mirror);
+      MESH_ASSERT(ok, "finer neighbour has no mirror inside its coarser neighbour");
+      (void)ok;
+      out.push_back({i, f, mirror});
     }
   }
+}
+
+}  // namespace
+
+template <int Dim>
+std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep) {
+  std::vector<FreeFacet<Dim>> out;
+  std::vector<std::size_t> nb;
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    if (keep[i]) leaf_free_facets(t, keys, keep, i, nb, out);
   return out;
+}
+
+template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep) {
+  return free_facets(t, LeafKeys<Dim>(t), keep);
+}
+
+// A leaf's free facets depend on its own flag and its face neighbours' (a symmetric relation in
+// a balanced tree), so only those of the changed leaves and their neighbours are rebuilt; the
+// rest are copied through in leaf order.
+template <int Dim>
+void update_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep,
+                        const std::vector<std::size_t>& changed, std::vector<FreeFacet<Dim>>& facets) {
+  std::vector<std::size_t> redo(changed), nb;
+  for (const std::size_t i : changed)
+    for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+      keys.face_neighbours(i, f, nb);
+      redo.insert(redo.end(), nb.begin(), nb.end());
+    }
+  std::sort(redo.begin(), redo.end());
+  redo.erase(std::unique(redo.begin(), redo.end()), redo.end());
+  std::vector<FreeFacet<Dim>> out;
+  out.reserve(facets.size() + 4 * redo.size());
+  std::size_t k = 0;  // next old facet
+  for (const std::size_t i : redo) {
+    for (; k < facets.size() && facets[k].leaf < i; ++k) out.push_back(facets[k]);
+    while (k < facets.size() && facets[k].leaf == i) ++k;  // leaf i's old facets
+    if (keep[i]) leaf_free_facets(t, keys, keep, i, nb, out);
+  }
+  out.insert(out.end(), facets.begin() + static_cast<std::ptrdiff_t>(k), facets.end());
+  facets = std::move(out);
 }
 
 template <int Dim>
@@ -89,6 +128,12 @@ template struct FreeFacet<2>;
 template struct FreeFacet<3>;
 template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const Flags&);
 template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const Flags&);
+template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const LeafKeys<2>&, const Flags&);
+template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, const Flags&);
+template void update_free_facets<2>(const Orthtree<2>&, const LeafKeys<2>&, const Flags&, const std::vector<std::size_t>&,
+                                    std::vector<FreeFacet<2>>&);
+template void update_free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, const Flags&, const std::vector<std::size_t>&,
+                                    std::vector<FreeFacet<3>>&);
 template bool segment_enters_kept<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&, double);
 template bool segment_enters_kept<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&, double);
 

@@ -24,6 +24,16 @@ template <int Dim> struct FreeFacet {
 /// All free facets of the kept leaves (keep[i] != 0), in leaf order then facet order.
 /// Requires a 2:1 face-balanced tree.
 template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep);
+/// The same, with the tree's leaf keys already built.
+template <int Dim>
+std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep);
+
+/// Turns `facets` = free_facets(t, keep before) into free_facets(t, keep) when keep differs
+/// only at the leaves `changed` (any order, repeats allowed): only those leaves and their face
+/// neighbours are looked at again. `keys` = LeafKeys(t).
+template <int Dim>
+void update_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep,
+                        const std::vector<std::size_t>& changed, std::vector<FreeFacet<Dim>>& facets);
 
 /// Does the segment [a, b] pass through the interior of a kept leaf? (The paper: the projection
 /// segments must not cross other quadrants.) Cells are shrunk by `rel_tol` of their size.

@@ -125,11 +125,12 @@ struct Chain {
 
 std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
   std::size_t removed = 0;
-  FreeEdges facets = edges ? std::move(*edges) : free_facets(t, in);
-  bool fresh = true;  // `facets` is free_facets(t, in)
+  const LeafKeys<2> keys(t);
+  FreeEdges facets = edges ? std::move(*edges) : free_facets(t, keys, in);
+  std::vector<std::size_t> dropped;  // since `facets` was free_facets(t, in)
   for (int pass = 0; pass < 64; ++pass) {
-    if (!fresh) facets = free_facets(t, in);
-    fresh = true;
+    if (!dropped.empty()) update_free_facets(t, keys, in, dropped, facets);
+    dropped.clear();
     std::map<LP, int> outgoing;  // ordered: deterministic
     for (const FreeFacet<2>& f : facets) ++outgoing[f.corners()[0]];
     std::vector<std::size_t> drop;
@@ -143,11 +144,13 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
       if (in[i]) {
         in[i] = 0;
         ++removed;
-        fresh = false;
+        dropped.push_back(i);
       }
     }
   }
-  if (edges) *edges = fresh ? std::move(facets) : free_facets(t, in);
+  if (!edges) return removed;
+  if (!dropped.empty()) update_free_facets(t, keys, in, dropped, facets);
+  *edges = std::move(facets);
   return removed;
 }
 
@@ -158,8 +161,8 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
     return 0;
   }
   std::size_t removed = 0;
-  FreeEdges facets;
-  bool fresh = false;  // `facets` is free_facets(t, in)
+  const LeafKeys<2> keys(t);
+  FreeEdges facets = free_facets(t, keys, in);
   // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
   // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
   // names its edge: edges of different lengths or axes never share one.
@@ -169,10 +172,11 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
     if (added) it->second = curve.closest_point(p).distance;
     return it->second;
   };
+  // Each pass looks again only where the last one dropped leaves (update_free_facets).
+  std::vector<std::size_t> drop;
   for (int pass = 0; pass < 4; ++pass) {
-    facets = free_facets(t, in);
-    fresh = true;
-    std::vector<std::size_t> drop;
+    if (pass > 0) update_free_facets(t, keys, in, drop, facets);
+    drop.clear();
     for (const FreeFacet<2>& f : facets) {
       const auto c = f.corners();
       const double h = facet_length(t, f);
@@ -188,9 +192,10 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
     if (drop.empty()) break;
     for (std::size_t i : drop) in[i] = 0;
     removed += drop.size();
-    fresh = false;
   }
-  if (edges) *edges = fresh ? std::move(facets) : free_facets(t, in);
+  if (!edges) return removed;
+  if (!drop.empty()) update_free_facets(t, keys, in, drop, facets);
+  *edges = std::move(facets);
   return removed;
 }
 
