@@ -6,7 +6,8 @@
 #include <cerrno>
 #include <charconv>
 #include <cstring>
-#include <fstream>
+#include <cstdio>
+#include <memory>
 
 #include "core/error.hpp"
 #include "core/mesh_topology.hpp"
@@ -16,8 +17,13 @@ namespace febemesh {
 
 namespace {
 
+/// Text built with std::to_chars; with a file it spills every few MiB, so the whole text is
+/// never held (it was the CLI's memory peak).
 class Text {
  public:
+  explicit Text(std::FILE* file = nullptr, std::string path = {}) : file_(file), path_(std::move(path)) {
+    if (file_) buf_.reserve(chunk + (1 << 16));
+  }
   Text& operator<<(std::string_view s) {
     buf_.append(s);
     return *this;
@@ -29,9 +35,22 @@ class Text {
     buf_.push_back(' ');
     return *this;
   }
+  void maybe_flush() {
+    if (file_ && buf_.size() >= chunk) flush();
+  }
+  void flush() {
+    if (file_ && !buf_.empty()) {
+      if (std::fwrite(buf_.data(), 1, buf_.size(), file_) != buf_.size())
+        throw InputError("cannot write " + path_ + ": " + std::strerror(errno));
+      buf_.clear();
+    }
+  }
   std::string take() { return std::move(buf_); }
 
  private:
+  static constexpr std::size_t chunk = 4 << 20;
+  std::FILE* file_;
+  std::string path_;
   std::string buf_;
 };
 
@@ -42,13 +61,18 @@ int vtk_local(ElemType t, int i) {
   return t == ElemType::Prism6 ? prism[i] : i;
 }
 
-template <class Num> void array(Text& out, const char* type, const char* name, int components, const std::vector<Num>& values) {
+/// A DataArray of `count` values, value(i) for i = 0, 1, ... in order, twelve to a line.
+template <class Value>
+void array(Text& out, const char* type, const char* name, int components, std::size_t count, Value&& value) {
   out << "        <DataArray type=\"" << type << "\" Name=\"" << name << "\"";
   if (components > 1) out << " NumberOfComponents=\"" << std::to_string(components) << "\"";
   out << " format=\"ascii\">\n";
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    out.num(values[i]);
-    if ((i + 1) % 12 == 0 || i + 1 == values.size()) out << "\n";
+  for (std::size_t i = 0; i < count; ++i) {
+    out.num(value(i));
+    if ((i + 1) % 12 == 0 || i + 1 == count) {
+      out << "\n";
+      out.maybe_flush();
+    }
   }
   out << "        </DataArray>\n";
 }
@@ -115,69 +139,99 @@ template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& m
   return out;
 }
 
-}  // namespace
+// Every array is generated from the mesh as it is written: the value arrays and the text were
+// ~2x the mesh at the CLI's memory peak. Connectivity and offsets walk the elements in order
+// (solid, then interface) with a cursor that the array's index follows.
+template <int Dim> void write_vtu_text(Text& out, const Mesh<Dim>& mesh) {
+  const std::size_t ns = mesh.solid.size(), ni = mesh.interface.size(), n = ns + ni;
+  const Elements* const parts[2] = {&mesh.solid, &mesh.interface};
+  auto element = [&](std::size_t c) { return c < ns ? std::pair{parts[0], c} : std::pair{parts[1], c - ns}; };
+  // The owners' level and from_boundary_cell for the interface cells.
+  std::vector<std::int32_t> owner;
+  if (ni != 0) owner = interface_owners<Dim>(mesh);
+  auto level_of = [&](std::size_t e) { return e < mesh.level.size() ? int(mesh.level[e]) : 0; };
+  auto from_boundary_of = [&](std::size_t e) {
+    return e < mesh.from_boundary_cell.size() ? int(mesh.from_boundary_cell[e]) : 0;
+  };
 
-template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh) {
-  const std::size_t ns = mesh.solid.size(), ni = mesh.interface.size();
-  std::vector<double> coords;
-  coords.reserve(3 * mesh.points.size());
-  for (const auto& p : mesh.points)
-    for (int d = 0; d < 3; ++d) coords.push_back(d < Dim ? p[d] : 0.0);
-
-  std::vector<std::int64_t> connectivity, offsets;
-  std::vector<int> types, level, from_boundary, group;
-  for (const Elements* els : {&mesh.solid, &mesh.interface}) {
-    for (std::size_t e = 0; e < els->size(); ++e) {
-      const ElemId id{static_cast<std::int32_t>(e)};
-      for (int i = 0; i < els->n_nodes_of(id); ++i) connectivity.push_back(els->nodes(id)[vtk_local(els->type[e], i)].v);
-      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
-      types.push_back(vtk_type(els->type[e]));
-      group.push_back(els == &mesh.solid ? 1 : 2);
-    }
-  }
-  std::vector<double> quality = scaled_jacobians<Dim>(mesh.solid, mesh.points);
-  const std::vector<double> iq = scaled_jacobians<Dim>(mesh.interface, mesh.points);
-  quality.insert(quality.end(), iq.begin(), iq.end());
-
-  for (std::size_t e = 0; e < ns; ++e) {
-    level.push_back(e < mesh.level.size() ? mesh.level[e] : 0);
-    from_boundary.push_back(e < mesh.from_boundary_cell.size() ? mesh.from_boundary_cell[e] : 0);
-  }
-  if (ni != 0) {
-    const std::vector<std::int32_t> owner = interface_owners<Dim>(mesh);
-    for (std::size_t e = 0; e < ni; ++e) {
-      level.push_back(owner[e] >= 0 ? level[owner[e]] : 0);
-      from_boundary.push_back(owner[e] >= 0 ? from_boundary[owner[e]] : 0);
-    }
-  }
-
-  Text out;
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
       << "  <UnstructuredGrid>\n"
       << "    <Piece NumberOfPoints=\"" << std::to_string(mesh.points.size()) << "\" NumberOfCells=\""
-      << std::to_string(ns + ni) << "\">\n"
+      << std::to_string(n) << "\">\n"
       << "      <Points>\n";
-  array(out, "Float64", "Points", 3, coords);
+  array(out, "Float64", "Points", 3, 3 * mesh.points.size(), [&](std::size_t i) {
+    const int d = static_cast<int>(i % 3);
+    return d < Dim ? mesh.points[i / 3][d] : 0.0;
+  });
   out << "      </Points>\n      <Cells>\n";
-  array(out, "Int64", "connectivity", 1, connectivity);
-  array(out, "Int64", "offsets", 1, offsets);
-  array(out, "UInt8", "types", 1, types);
+  {
+    std::size_t cell = 0;
+    int local = 0;
+    std::size_t n_conn = 0;
+    for (std::size_t c = 0; c < n; ++c) {
+      const auto [els, e] = element(c);
+      n_conn += static_cast<std::size_t>(els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)}));
+    }
+    array(out, "Int64", "connectivity", 1, n_conn, [&](std::size_t) {
+      for (;; local = 0, ++cell) {
+        const auto [els, e] = element(cell);
+        const ElemId id{static_cast<std::int32_t>(e)};
+        const int nn = els->n_nodes_of(id);
+        if (local == nn) continue;
+        const auto v = static_cast<std::int64_t>(els->nodes(id)[vtk_local(els->type[e], local)].v);
+        if (++local == nn) local = 0, ++cell;
+        return v;
+      }
+    });
+  }
+  {
+    std::int64_t end = 0;
+    array(out, "Int64", "offsets", 1, n, [&](std::size_t c) {
+      const auto [els, e] = element(c);
+      end += els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
+      return end;
+    });
+  }
+  array(out, "UInt8", "types", 1, n, [&](std::size_t c) {
+    const auto [els, e] = element(c);
+    return vtk_type(els->type[e]);
+  });
   out << "      </Cells>\n      <CellData Scalars=\"quality\">\n";
-  array(out, "Float64", "quality", 1, quality);
-  array(out, "Int32", "level", 1, level);
-  array(out, "Int32", "from_boundary_cell", 1, from_boundary);
-  array(out, "Int32", "group", 1, group);
+  array(out, "Float64", "quality", 1, n, [&](std::size_t c) {
+    const auto [els, e] = element(c);
+    const auto ep = element_points<Dim>(*els, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+    return scaled_jacobian<Dim>(els->type[e], ep.span());
+  });
+  array(out, "Int32", "level", 1, n, [&](std::size_t c) {
+    if (c < ns) return level_of(c);
+    const std::int32_t o = owner[c - ns];
+    return o >= 0 ? level_of(static_cast<std::size_t>(o)) : 0;
+  });
+  array(out, "Int32", "from_boundary_cell", 1, n, [&](std::size_t c) {
+    if (c < ns) return from_boundary_of(c);
+    const std::int32_t o = owner[c - ns];
+    return o >= 0 ? from_boundary_of(static_cast<std::size_t>(o)) : 0;
+  });
+  array(out, "Int32", "group", 1, n, [&](std::size_t c) { return c < ns ? 1 : 2; });
   out << "      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+}
+
+}  // namespace
+
+template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh) {
+  Text out;
+  write_vtu_text<Dim>(out, mesh);
   return out.take();
 }
 
 template <int Dim> void write_vtu(const Mesh<Dim>& mesh, const std::filesystem::path& path) {
-  const std::string text = vtu_string<Dim>(mesh);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError("cannot open " + path.string() + " for writing: " + std::strerror(errno));
-  out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  if (!out) throw InputError("cannot write " + path.string());
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "wb"), &std::fclose);
+  if (!file) throw InputError("cannot open " + path.string() + " for writing: " + std::strerror(errno));
+  Text out(file.get(), path.string());
+  write_vtu_text<Dim>(out, mesh);
+  out.flush();
+  if (std::fflush(file.get()) != 0) throw InputError("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
 template std::string vtu_string<2>(const Mesh<2>&);
