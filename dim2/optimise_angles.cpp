@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace febemesh::dim2 {
 namespace {
@@ -98,19 +99,69 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     return q;
   };
   // The q of every element, refreshed when one of its nodes moves: most nodes are already
-  // above the target and are skipped on these cached values (the same numbers).
+  // above the target and are skipped on these cached values (the same numbers). An element
+  // clearly above the target (clearly_above: no atan2) holds NaN until a node of it moves: it
+  // cannot be the worst of a node below the target, nor of the mesh while one is below.
   std::vector<double> q_elem(n_elems);
-  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = scaled_quality(e);
-  // q_elem is refreshed wherever a node moves, so it is the mesh's q before and after.
+  // Corner angles that keep q above target + a margin (1e-3 deg): triangles at least
+  // tri_deg, quad corners within [quad_deg, 180 - quad_deg]; their cotangents' bounds.
+  const double tri_deg = (triangle_bar_deg * opt.target / triangle_scale) + 1e-3;
+  const double quad_deg = quad_bar_deg * opt.target + 1e-3;
+  const double tri_cot = tri_deg < 90.0 ? 1.0 / std::tan(tri_deg * M_PI / 180.0) : -1e300;
+  const double quad_cot = quad_deg < 90.0 ? 1.0 / std::tan(quad_deg * M_PI / 180.0) : -1e300;
+  // How bad an element's worst corner is, without atan2: triangles their largest corner
+  // cotangent, quads their largest |cotangent| (q falls as it rises, for each kind); +inf when
+  // a corner is reflex or inverted or the quotient is not finite (then only q itself tells).
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  auto badness = [&](std::size_t e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const int n = m.solid.n_nodes_of(id);
+    const VertexId* ev = m.solid.nodes(id);
+    double worst = -inf;
+    for (int k = 0; k < n; ++k) {
+      const P2 &prev = m.points[ev[(k + n - 1) % n].v], &cur = m.points[ev[k].v], &next = m.points[ev[(k + 1) % n].v];
+      const P2 a = prev - cur, b = next - cur;
+      const double cr = b[0] * a[1] - b[1] * a[0];
+      if (!(cr > 0)) return inf;
+      const double c = a.dot(b) / cr;
+      if (!std::isfinite(c)) return inf;
+      worst = std::max(worst, n == 3 ? c : std::abs(c));
+    }
+    return worst;
+  };
+  auto clearly_above = [&](std::size_t e) {
+    return badness(e) < (m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? tri_cot : quad_cot);
+  };
+  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = clearly_above(e) ? std::nan("") : scaled_quality(e);
+  // The mesh's worst q: the measured elements' when one is at or below the target (the others
+  // are above it). Else, per kind, it is held by an element within rounding (1e-9 of 1 + b^2)
+  // of the kind's largest badness; only those (and the measured ones) are measured.
   auto mesh_worst = [&] {
     double q = 1e300;
-    for (const double qe : q_elem) q = std::min(q, qe);
-    return n_elems ? q : 0.0;
+    for (const double qe : q_elem)
+      if (!std::isnan(qe)) q = std::min(q, qe);
+    if (q <= opt.target || n_elems == 0) return n_elems ? q : 0.0;
+    double top[2] = {-inf, -inf};  // triangles, quads
+    for (std::size_t e = 0; e < n_elems; ++e) {
+      if (!std::isnan(q_elem[e])) continue;
+      const double b = badness(e);
+      double& t = top[m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? 0 : 1];
+      if (std::isfinite(b)) t = std::max(t, b);
+    }
+    for (std::size_t e = 0; e < n_elems; ++e) {
+      if (!std::isnan(q_elem[e])) continue;
+      const double b = badness(e), t = top[m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? 0 : 1];
+      if (!std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t)) q = std::min(q, scaled_quality(e));
+    }
+    return q;
   };
   st.worst_before = mesh_worst();
+  // The worst cached q around v; at least the target when all of v's elements are clearly
+  // above it (then v is skipped, as with their exact q).
   auto cached_worst = [&](std::size_t v) {
     double q = 1e300;
-    for (std::int32_t k = first[v]; k < first[v + 1]; ++k) q = std::min(q, q_elem[incident[k]]);
+    for (std::int32_t k = first[v]; k < first[v + 1]; ++k)
+      if (!std::isnan(q_elem[incident[k]])) q = std::min(q, q_elem[incident[k]]);
     return q;
   };
   // local_worst with node v at p (the node is put back afterwards).
