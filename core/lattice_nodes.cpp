@@ -93,6 +93,10 @@ template <int Dim> std::int32_t LatticeNodes<Dim>::find(const LatticePoint<Dim>&
 }
 
 template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep) {
+  return lattice_nodes(t, keep, HangingFlags::Computed);
+}
+
+template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, HangingFlags hanging) {
   if (keep != nullptr && keep->size() != t.n_leaves()) {
     throw InputError("lattice_nodes: keep mask has " + std::to_string(keep->size()) + " entries for " +
                      std::to_string(t.n_leaves()) + " leaves");
@@ -131,6 +135,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
     }
   }
 
+  if (hanging == HangingFlags::Skipped) return nodes;
   // The leaves touching node p are those containing the 2^Dim finest lattice cells around p.
   const LeafKeys<Dim> leaf_keys(t);
   // Nodes come in Morton order, so each of the 2^Dim cells around them moves little in the
@@ -163,5 +168,7 @@ template struct LatticeNodes<2>;
 template struct LatticeNodes<3>;
 template LatticeNodes<2> lattice_nodes<2>(const Orthtree<2>&, const Flags*);
 template LatticeNodes<3> lattice_nodes<3>(const Orthtree<3>&, const Flags*);
+template LatticeNodes<2> lattice_nodes<2>(const Orthtree<2>&, const Flags*, HangingFlags);
+template LatticeNodes<3> lattice_nodes<3>(const Orthtree<3>&, const Flags*, HangingFlags);
 
 }  // namespace febemesh

@@ -203,7 +203,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
                                              const BoundaryQuadrantOptions& opt, const FreeEdges* edges) {
   QuadrantComplexResult res;
   QuadrantComplex& qc = res.complex;
-  const LatticeNodes<2> nodes = lattice_nodes(t, &in);
+  const LatticeNodes<2> nodes = lattice_nodes(t, &in, HangingFlags::Skipped);
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
   std::vector<std::uint64_t> node_keys(nodes.points.size());
