@@ -104,19 +104,21 @@ inline double element_top_cot(const Mesh<2>& m, std::size_t e) {
 
 /// Whether angle a exceeds angle b + eps (degrees, 0 <= eps <= 1e-6), where ca and cb are the
 /// angles' cotangents (as polygon_top_cot gives them) and exact_a / exact_b their degrees as
-/// polygon_min_angle_n gives them. The angle acot(c) falls by at least dc / (1 + c^2) over
-/// [c, c + dc], so cotangents further apart than (eps in radians + 1e-11) (1 + c^2) decide as
-/// the degrees would: the degrees agree with acot of the cotangent to ~1e-15 rad (one rounding
-/// in the quotient, atan2's own error, and the element's smallest angle is that of its largest
-/// cotangent up to those), and a smallest angle over elements whose cotangents lie within
-/// 2e-12 (1 + c^2) of the largest (a tie, see improve_mesh) lies within 2e-12 rad of acot of it:
-/// both far inside 1e-11. Closer ones, and non-finite ones, are decided on
-/// the exact degrees, which are computed only then (atan2 is most of an angle's cost).
+/// polygon_min_angle_n gives them. For ca < cb, acot(ca) - acot(cb) = integral of 1 / (1 + c^2)
+/// over [ca, cb], between (cb - ca) / (1 + max c^2) and (cb - ca) / (1 + min c^2) (min c^2 = 0
+/// when the signs differ). The degrees are acot of the cotangent up to ~2e-15 rad each (the
+/// quotient's rounding, atan2's 1-2 ulp, the two roundings of * 180 / pi; an element's smallest
+/// angle is its largest cotangent's, up to those), so when those bounds clear eps (in radians)
+/// by 8e-15 either way the degrees decide the same; only the rest (and non-finite cotangents)
+/// are decided on the exact degrees, computed only then (atan2 is most of an angle's cost).
 template <class A, class B> bool exceeds(double ca, A&& exact_a, double cb, B&& exact_b, double eps) {
   if (std::isfinite(ca) && std::isfinite(cb)) {
-    const double band = (eps * (M_PI / 180.0) + 1e-11) * (1.0 + std::max(ca * ca, cb * cb));
-    if (cb - ca > band) return true;
-    if (ca - cb > band) return false;
+    constexpr double slack = 8e-15;
+    const double d = cb - ca, e = eps * (M_PI / 180.0);
+    const double hi2 = std::max(ca * ca, cb * cb), lo2 = (ca > 0) == (cb > 0) ? std::min(ca * ca, cb * cb) : 0.0;
+    const double lower = d / (1.0 + (d >= 0 ? hi2 : lo2)), upper = d / (1.0 + (d >= 0 ? lo2 : hi2));
+    if (lower > e + slack) return true;
+    if (upper < e - slack) return false;
   }
   return exact_a() > exact_b() + eps;
 }
