@@ -518,7 +518,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         pnode[k] = node;
         if (corner_at[k] < 0) return;
         qc.points[node] = curve.corners()[corner_at[k]].point;
-        qc.where[node] = corner_location(corner_at[k]);
+        qc.where(node) = corner_location(corner_at[k]);
       };
       if (k > 0 && v[k] == v[k - 1]) {
         share(pnode[k - 1]);
@@ -568,7 +568,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         const Point<2>& c = curve.corners()[corner_after[k]].point;
         if ((qc.points[pnode[j]] - c).norm() > 1e-9 * h[k]) continue;
         qc.points[pnode[j]] = c;
-        qc.where[pnode[j]] = corner_location(corner_after[k]);
+        qc.where(pnode[j]) = corner_location(corner_after[k]);
         corner_after[k] = -1;
       }
       if (corner_after[k] >= 0) {

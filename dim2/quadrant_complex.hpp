@@ -73,16 +73,36 @@ struct BoundaryQuadrant {
 struct QuadrantComplex {
   std::vector<Point<2>> points;
   std::vector<NodeKind> kind;
-  std::vector<BoundaryLocation> where;  ///< meaningful for Boundary nodes
   std::vector<InteriorQuadrant> interior;
   std::vector<BoundaryQuadrant> boundary;
 
+  /// Where Boundary node i lies on the curve. Requires kind[i] == NodeKind::Boundary.
+  BoundaryLocation& where(std::int32_t i) { return where_[index_of(i)]; }
+  const BoundaryLocation& where(std::int32_t i) const { return where_[index_of(i)]; }
+
+  /// Lattice nodes (Interior, Chain) first, then Boundary nodes: only these have a location
+  /// (32 bytes a node for every node was ~16 bytes an element at the run's memory peak).
   std::int32_t add_node(const Point<2>& p, NodeKind k, const BoundaryLocation& w = {}) {
+    const auto i = static_cast<std::int32_t>(points.size());
+    if (k == NodeKind::Boundary) {
+      if (where_.empty()) first_boundary_ = i;
+      MESH_ASSERT(std::size_t(i - first_boundary_) == where_.size(), "boundary node " << i << " after a lattice node");
+      where_.push_back(w);
+    } else {
+      MESH_ASSERT(where_.empty(), "lattice node " << i << " after a boundary node");
+    }
     points.push_back(p);
     kind.push_back(k);
-    where.push_back(w);
-    return static_cast<std::int32_t>(points.size() - 1);
+    return i;
   }
+
+ private:
+  std::size_t index_of(std::int32_t i) const {
+    MESH_ASSERT(i >= first_boundary_ && std::size_t(i - first_boundary_) < where_.size(), "node " << i << " has no location");
+    return static_cast<std::size_t>(i - first_boundary_);
+  }
+  std::vector<BoundaryLocation> where_;
+  std::int32_t first_boundary_ = 0;
 };
 
 }  // namespace febemesh::dim2

@@ -240,7 +240,7 @@ FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidp
   b.out.mesh.points.assign(qc.points.begin(), qc.points.end());
   b.out.where.resize(qc.points.size());
   for (std::size_t i = 0; i < qc.points.size(); ++i)
-    if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where[i];
+    if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where(static_cast<std::int32_t>(i));
   interior_templates(b, qc, base);
   boundary_templates(b, qc, base);
   if (kind == ElementKind::Quad) return split_to_quads(b.out, midpoint);

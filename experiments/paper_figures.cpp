@@ -240,7 +240,7 @@ std::size_t pick_boundary_quadrant(const QuadrantComplex& qc, const CurveBoundar
     if (b.is_triangle() || b.corner >= 0) continue;
     const P2 q2 = qc.points[std::size_t(b.node[0])], q1 = qc.points[std::size_t(b.node[1])];
     const P2 p1 = qc.points[std::size_t(b.node[2])], p2 = qc.points[std::size_t(b.node[3])];
-    const BoundaryLocation& w = qc.where[std::size_t(b.node[2])];
+    const BoundaryLocation& w = qc.where(b.node[2]);
     if (w.kind != BoundaryLocation::Kind::Smooth || w.patch < 0) continue;
     const P2 edge = (q2 - q1).normalized();
     const double score = std::abs((p1 - q1).normalized().dot(edge)) + std::abs((p2 - q2).normalized().dot(edge)) +
