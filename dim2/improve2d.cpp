@@ -216,33 +216,48 @@ int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
 // edge flipped, candidate edges are those of elements below `good`, and adjacency is CSR built
 // once per pass; the visiting order (edges by key, nodes by index) is the plain algorithm's, so
 // the result is the same as recomputing everything.
-std::vector<std::vector<std::int32_t>> interface_neighbours(const Mesh<2>& m) {
-  std::vector<std::vector<std::int32_t>> nbr(m.points.size());
+InterfaceNeighbours interface_neighbours(const Mesh<2>& m) {
+  InterfaceNeighbours out;
+  out.first.assign(m.points.size() + 1, 0);
   for (std::size_t e = 0; e < m.interface.size(); ++e) {
     const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
-    nbr[v[0].v].push_back(v[1].v);
-    nbr[v[1].v].push_back(v[0].v);
+    ++out.first[v[0].v + 1];
+    ++out.first[v[1].v + 1];
   }
-  for (auto& nb : nbr) {
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  for (std::size_t v = 0; v + 1 < out.first.size(); ++v) out.first[v + 1] += out.first[v];
+  std::vector<std::int32_t> nbr(static_cast<std::size_t>(out.first.back()));
+  {
+    std::vector<std::int32_t> fill(out.first.begin(), out.first.end() - 1);
+    for (std::size_t e = 0; e < m.interface.size(); ++e) {
+      const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+      nbr[fill[v[0].v]++] = v[1].v;
+      nbr[fill[v[1].v]++] = v[0].v;
+    }
   }
-  return nbr;
+  // Sorted and deduplicated per node, compacted in place.
+  out.nbr.reserve(nbr.size());
+  for (std::size_t v = 0; v + 1 < out.first.size(); ++v) {
+    const auto b = nbr.begin() + out.first[v], e = nbr.begin() + out.first[v + 1];
+    std::sort(b, e);
+    out.first[v] = static_cast<std::int32_t>(out.nbr.size());
+    for (auto it = b; it != e; ++it)
+      if (it == b || *it != *(it - 1)) out.nbr.push_back(*it);
+  }
+  out.first.back() = static_cast<std::int32_t>(out.nbr.size());
+  return out;
 }
 
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
   constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
-  // Each element's smallest angle as its largest corner cotangent (cot) with the exact degrees
-  // (deg, element_min_angle bit for bit) computed the first time a comparison needs them; every
-  // decision below is the one the degrees make (exceeds).
-  std::vector<double> cot(m.solid.size()), deg(m.solid.size(), unknown);
+  // Each element's smallest angle as its largest corner cotangent (cot); the exact degrees
+  // (element_min_angle) are computed, not kept, when a comparison needs them (rarely: a cache
+  // was 8 bytes an element at this stage's memory); every decision below is the one the
+  // degrees make (exceeds).
+  std::vector<double> cot(m.solid.size());
   for (std::size_t e = 0; e < m.solid.size(); ++e) cot[e] = element_top_cot(m, e);
-  auto exact = [&](std::size_t e) {
-    if (std::isnan(deg[e])) deg[e] = element_min_angle(m, e);
-    return deg[e];
-  };
+  auto exact = [&](std::size_t e) { return element_min_angle(m, e); };
   // The smallest degrees over the mesh: only elements within rounding of the largest
   // cotangent (or without a finite one) can hold it.
   auto mesh_min = [&] {
@@ -268,7 +283,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     interface_edge.push_back(key_of(v[0].v, v[1].v));
   }
   std::sort(interface_edge.begin(), interface_edge.end());
-  const std::vector<std::vector<std::int32_t>> curve_neighbours = interface_neighbours(m);
+  const InterfaceNeighbours curve_neighbours = interface_neighbours(m);
 
   // Flips are tried only on edges of elements below `good` degrees: the interior templates have
   // 45 degrees already, so flipping costs little beyond the boundary layer.
@@ -344,8 +359,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
         touched[e0] = touched[e1] = 1;
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
-        cot[e0] = tc[2], deg[e0] = td[2];
-        cot[e1] = tc[3], deg[e1] = td[3];
+        cot[e0] = tc[2];
+        cot[e1] = tc[3];
         ++flips;
       }
       st.flips += flips;
@@ -359,7 +374,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       const auto elems = incident.of(static_cast<std::int32_t>(v));
       if ((locked[v] && !sliding) || elems.empty() || settled[v]) continue;
       if (sliding) {
-        nb = curve_neighbours[v];
+        nb.assign(curve_neighbours.of(v).begin(), curve_neighbours.of(v).end());
       } else {
         nb.clear();
         for (const std::int32_t e : elems) {
@@ -442,7 +457,6 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         ++st.moves;
         for (std::size_t k = 0; k < elems.size(); ++k) {
           cot[elems[k]] = trial_cot[k];  // the accepted trial's
-          deg[elems[k]] = trial_deg[k];
           const ElemId id{elems[k]};
           const VertexId* ev = m.solid.nodes(id);
           for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;

@@ -48,10 +48,13 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     for (int k = 0; k < m.solid.n_nodes_of(id); ++k) ++first[m.solid.nodes(id)[k].v + 1];
   }
   for (std::size_t v = 0; v < n_nodes; ++v) first[v + 1] += first[v];
-  std::vector<std::int32_t> incident(first.back()), fill(first.begin(), first.end() - 1);
-  for (std::size_t e = 0; e < n_elems; ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
+  std::vector<std::int32_t> incident(first.back());
+  {
+    std::vector<std::int32_t> fill(first.begin(), first.end() - 1);  // (freed here: this is the run's memory peak)
+    for (std::size_t e = 0; e < n_elems; ++e) {
+      const ElemId id{static_cast<std::int32_t>(e)};
+      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
+    }
   }
   // Edge neighbours of each node from its incident elements (each node's few, sorted locally).
   std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
@@ -82,12 +85,11 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   };
 
   // The BE chord neighbours of each interface node, for the chord bound.
-  const std::vector<std::vector<std::int32_t>> chord_nbr =
-      opt.curve_distance ? interface_neighbours(m) : std::vector<std::vector<std::int32_t>>();
+  const InterfaceNeighbours chord_nbr = opt.curve_distance ? interface_neighbours(m) : InterfaceNeighbours();
   // How far v's chords stray from the curve with v at p (their midpoints' distance).
   auto chord_deviation = [&](std::size_t v, const P2& p) {
     double d = 0.0;
-    for (const std::int32_t u : chord_nbr[v]) d = std::max(d, opt.curve_distance(0.5 * (p + m.points[u])));
+    for (const std::int32_t u : chord_nbr.of(v)) d = std::max(d, opt.curve_distance(0.5 * (p + m.points[u])));
     return d;
   };
 
@@ -195,7 +197,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       const P2 start = m.points[v];
       // A candidate as the node would really sit there (on the curve for sliding nodes).
       auto place = [&](const P2& p) { return lock == 2 ? slide(static_cast<std::int32_t>(v), p) : p; };
-      const bool bound_chords = lock == 2 && !chord_nbr.empty();
+      const bool bound_chords = lock == 2 && !chord_nbr.first.empty();
       const double chord_limit = bound_chords ? chord_deviation(v, start) : 0.0;
       P2 best = start, centroid = P2::Zero();
       double h = 0.0;
