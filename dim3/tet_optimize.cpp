@@ -54,6 +54,15 @@ struct Optimizer {
   std::vector<std::array<std::int32_t, 3>> faces;  // interface triangles
   std::vector<std::int32_t> f_start, f_incident;   // CSR node -> interface triangles
   std::vector<P3> node_normal;                     // surface normal at each surface node
+  /// tet_search_quality of every tetrahedron at the current points, refreshed when a node
+  /// moves (the same function of the same numbers, so the same values as recomputing).
+  std::vector<double> tet_q;
+  void refresh_quality(std::int32_t v) {
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+      const Tet& t = tets[incident[k]];
+      tet_q[incident[k]] = tet_search_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+    }
+  }
 
   /// Search quality of interface triangle f with node v at x (normal nx there): +inf when it
   /// is aligned with the surface, else like an inverted tetrahedron (-1 + cosine, in [-2, -1]).
@@ -92,12 +101,19 @@ struct Optimizer {
     return w;
   }
   /// Like worst_at, but stops as soon as one tetrahedron is at or below `bound` (the answer
-  /// is then some value <= bound).
-  double worst_above(std::int32_t v, const P3& x, double bound) const {
+  /// is then some value <= bound). The incident tetrahedron `first` (an index into them, the one
+  /// likeliest to fail) is tried first and becomes the one that failed; the order changes only
+  /// which value <= bound is returned, never whether one is.
+  double worst_above(std::int32_t v, const P3& x, double bound, std::int32_t& first) const {
+    const std::int32_t n = start[v + 1] - start[v];
     double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
-      w = std::min(w, quality_at(incident[k], v, x));
-      if (w <= bound) return w;
+    for (std::int32_t j = 0; j < n; ++j) {
+      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
+      w = std::min(w, quality_at(incident[start[v] + i], v, x));
+      if (w <= bound) {
+        first = i;
+        return w;
+      }
     }
     return w;
   }
@@ -221,10 +237,13 @@ struct Optimizer {
   /// One local search at node v; returns true if it moved.
   bool relax(std::int32_t v) {
     const P3 x0 = mesh.points[v];
-    std::int32_t worst_tet = -1;
+    std::int32_t worst_tet = -1, worst_local = 0;
     const bool surf = is_surface(v);
     const bool guard = surf && !f_start.empty();
-    const double f0 = std::min(worst_at(v, x0, &worst_tet), guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
+    double tets_worst = std::numeric_limits<double>::infinity();
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
+      if (tet_q[incident[k]] < tets_worst) tets_worst = tet_q[incident[k]], worst_tet = incident[k], worst_local = k - start[v];
+    const double f0 = std::min(tets_worst, guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
     if (opt.untangle_only ? f0 > 0 : f0 >= opt.target_dihedral_deg * pi / 180.0) return false;
     double len = 0.0;
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) len += (mesh.points[nbs[k]] - x0).norm();
@@ -232,38 +251,41 @@ struct Optimizer {
     if (len <= 0) return false;
     const double h = 1e-4 * len;
 
-    std::vector<P3> dirs;
+    std::array<P3, 2> dirs;
+    int n_dirs = 0;
     const P3 g = gradient(worst_tet, v, x0, h);
-    if (g.norm() > 0) dirs.push_back(g.normalized());
+    if (g.norm() > 0) dirs[n_dirs++] = g.normalized();
     P3 sum = P3::Zero();
-    const double margin = f0 <= 0 ? 0.0 : 0.02;
+    const double near = f0 <= 0 ? f0 : f0 + 0.02;
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
       const std::int32_t t = incident[k];
-      const double q = quality_at(t, v, x0);
-      if (q <= f0 + margin || (f0 <= 0 && q <= 0)) {
+      const double q = tet_q[t];
+      if (q <= near || (f0 <= 0 && q <= 0)) {
         const P3 gt = gradient(t, v, x0, h);
         if (gt.norm() > 0) sum += gt.normalized();
       }
     }
-    if (sum.norm() > 0) dirs.push_back(sum.normalized());
+    if (sum.norm() > 0) dirs[n_dirs++] = sum.normalized();
 
-    std::vector<P3> cands;
+    std::array<P3, 10> cands;
+    int n_cands = 0;
     P3 centroid = P3::Zero();
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) centroid += mesh.points[nbs[k]];
     centroid /= std::max<std::int32_t>(1, nb_start[v + 1] - nb_start[v]);
-    cands.push_back(centroid);
-    cands.push_back(0.5 * (centroid + x0));
-    for (const P3& d : dirs)
-      for (double s : {0.25, 0.08, 0.025, 0.006}) cands.push_back(x0 + s * len * d);
+    cands[n_cands++] = centroid;
+    cands[n_cands++] = 0.5 * (centroid + x0);
+    for (int i = 0; i < n_dirs; ++i)
+      for (double s : {0.25, 0.08, 0.025, 0.006}) cands[n_cands++] = x0 + s * len * dirs[i];
 
     double best = f0;
     P3 best_x = x0;
     BoundaryLocation best_w = surf ? where[v] : BoundaryLocation{};
-    for (const P3& c : cands) {
+    for (int i = 0; i < n_cands; ++i) {
+      const P3& c = cands[i];
       P3 x = c;
       BoundaryLocation w;
       if (surf) std::tie(x, w) = opt.project(c);
-      double f = worst_above(v, x, best + 1e-12);
+      double f = worst_above(v, x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w;
     }
@@ -277,6 +299,7 @@ struct Optimizer {
     }
     if (best_x == x0) return false;
     mesh.points[v] = best_x;
+    refresh_quality(v);
     if (surf) where[v] = best_w;
     if (guard) node_normal[v] = opt.surface_normal(best_w);
     return true;
@@ -302,7 +325,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -379,23 +402,31 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
   const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
   std::vector<std::uint8_t> active(n, 0);
-  for (const Tet& t : o.tets) {
+  o.tet_q.resize(o.tets.size());
+  for (std::size_t i = 0; i < o.tets.size(); ++i) {
+    const Tet& t = o.tets[i];
     const double q = tet_search_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+    o.tet_q[i] = q;
     if (opt.untangle_only ? q <= 0 : q < target)
       for (std::int32_t v : t) active[v] = 1;
   }
   for (std::size_t f = 0; f < o.faces.size(); ++f)
     if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0)
       for (std::int32_t v : o.faces[f]) active[v] = 1;
+  // stale[v]: v or a neighbour moved since v's last local search. A search that did not move
+  // v, repeated with the same numbers, does not move it either: such nodes are skipped (the
+  // moves, and so the mesh, are those of searching them again).
+  std::vector<std::uint8_t> stale(n, 1), next(n, 0);
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
-    std::vector<std::uint8_t> next(n, 0);
+    std::fill(next.begin(), next.end(), 0);
     std::size_t moved = 0;
     for (std::size_t v = 0; v < n; ++v) {
-      if (!active[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+      if (!active[v] || !stale[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+      stale[v] = 0;
       if (!o.relax(static_cast<std::int32_t>(v))) continue;
       ++moved;
-      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1;
-      next[v] = 1;
+      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1, stale[o.nbs[k]] = 1;
+      next[v] = 1, stale[v] = 1;
     }
     st.sweeps = sweep + 1;
     st.moves += moved;
