@@ -105,17 +105,12 @@ struct Optimizer {
   std::vector<std::array<std::int32_t, 3>> faces;  // interface triangles
   std::vector<std::int32_t> f_start, f_incident;   // CSR node -> interface triangles
   std::vector<P3> node_normal;                     // surface normal at each surface node
-  /// tet_search_quality of every tetrahedron at the current points, refreshed when a node
-  /// moves (the same function of the same numbers, so the same values as recomputing).
+  /// The search rank of every tetrahedron at the current points: tet_search_rank at the
+  /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
   std::vector<double> tet_q;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
   std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
-  void refresh_quality(std::int32_t v) {
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
-      const Tet& t = tets[incident[k]];
-      tet_q[incident[k]] = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
-    }
-  }
+  std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
 
   /// Search quality of interface triangle f with node v at x (normal nx there): +inf when it
   /// is aligned with the surface, else like an inverted tetrahedron (-1 + cosine, in [-2, -1]).
@@ -181,12 +176,14 @@ struct Optimizer {
     return g;
   }
   /// worst_above over `local` (relax's incident tetrahedra).
-  double local_worst_above(const P3& x, double bound, std::int32_t& first) const {
+  /// Without an early stop, trial[i] holds every incident tetrahedron's rank at x.
+  double local_worst_above(const P3& x, double bound, std::int32_t& first) {
     const std::int32_t n = static_cast<std::int32_t>(local.size());
     double w = std::numeric_limits<double>::infinity();
     for (std::int32_t j = 0; j < n; ++j) {
       const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
-      w = std::min(w, local[i].rank(x));
+      trial[i] = local[i].rank(x);
+      w = std::min(w, trial[i]);
       if (w <= bound) {
         first = i;
         return w;
@@ -335,6 +332,8 @@ struct Optimizer {
     const double h = 1e-4 * len;
 
     local.resize(static_cast<std::size_t>(start[v + 1] - start[v]));
+    trial.resize(local.size());
+    best_ranks.resize(local.size());
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) local[k - start[v]].set(tets[incident[k]], v, mesh.points);
     std::array<P3, 2> dirs;
     int n_dirs = 0;
@@ -373,7 +372,7 @@ struct Optimizer {
       if (surf) std::tie(x, w) = opt.project(c);
       double f = local_worst_above(x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
-      if (f > best + 1e-12) best = f, best_x = x, best_w = w;
+      if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }
     if (opt.untangle_only && opt.escobar && !(best > 0) && (!surf || opt.escobar_surface)) {
       // The max-min candidates did not untangle this node's tetrahedra: descend the smooth
@@ -381,11 +380,16 @@ struct Optimizer {
       P3 ex;
       BoundaryLocation ew;
       const P3 from = best_x;
-      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) best_x = ex, best_w = ew;
+      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) {
+        best_x = ex, best_w = ew;
+        for (std::size_t k = 0; k < local.size(); ++k) best_ranks[k] = local[k].rank(ex);
+      }
     }
     if (best_x == x0) return false;
     mesh.points[v] = best_x;
-    refresh_quality(v);
+    // The ranks at the new point were computed for the accepted candidate (all of them: it
+    // was not stopped early).
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) tet_q[incident[k]] = best_ranks[k - start[v]];
     if (surf) where[v] = best_w;
     if (guard) node_normal[v] = opt.surface_normal(best_w);
     return true;
@@ -440,7 +444,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}, {}, {}};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
