@@ -198,12 +198,40 @@ template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>
   return std::clamp(m * normalisation(t), -1.0, 1.0);
 }
 
+namespace {
+
+/// jacobians() of a tetrahedron: the corners of tet_corners in their order, with the same
+/// numbers, but each of the six edge lengths computed once (|p - q| and |q - p| are the same
+/// bits), not once per corner that uses it (the smoothing guard's hot path).
+std::pair<double, double> tet_jacobians(std::span<const Point<3>> p) {
+  const Point<3> e01 = p[1] - p[0], e02 = p[2] - p[0], e03 = p[3] - p[0], e12 = p[2] - p[1], e13 = p[3] - p[1],
+                 e23 = p[3] - p[2];
+  const double l01 = e01.norm(), l02 = e02.norm(), l03 = e03.norm(), l12 = e12.norm(), l13 = e13.norm(),
+               l23 = e23.norm();
+  // Corner (c; a, b, d): J = (a - c) . ((b - c) x (d - c)), lengths |a - c| |b - c| |d - c|.
+  const double j[4] = {det3<3>(e01, e02, e03), det3<3>(e12, Point<3>(p[0] - p[1]), e13),
+                       det3<3>(Point<3>(p[0] - p[2]), Point<3>(p[1] - p[2]), e23),
+                       det3<3>(Point<3>(p[0] - p[3]), Point<3>(p[2] - p[3]), Point<3>(p[1] - p[3]))};
+  const double len[4] = {l01 * l02 * l03, l12 * l01 * l13, l02 * l12 * l23, l03 * l23 * l13};
+  double m = inf, s = inf;
+  for (int k = 0; k < 4; ++k) {
+    m = std::min(m, j[k]);
+    s = std::min(s, len[k] > 0.0 ? j[k] / len[k] : 0.0);
+  }
+  return {m, std::clamp(s * normalisation(ElemType::Tet4), -1.0, 1.0)};
+}
+
+}  // namespace
+
 template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p) {
   if constexpr (Dim == 2) {
     if (t == ElemType::Tri3) return polygon_jacobians<3>(p, normalisation(t));
     if (t == ElemType::Quad4) return polygon_jacobians<4>(p, normalisation(t));
   }
   if (t == ElemType::Line2) return {min_corner_jacobian<Dim>(t, p), scaled_jacobian<Dim>(t, p)};
+  if constexpr (Dim == 3) {
+    if (t == ElemType::Tet4) return tet_jacobians(p);
+  }
   double m = inf, s = inf;
   for (const Corner& k : corners(t)) {
     const auto [jac, lengths] = corner_jacobian<Dim>(t, k, p);

@@ -3,6 +3,7 @@
 #include "core/smooth.hpp"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 #include "core/error.hpp"
@@ -101,15 +102,26 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   Elements boundary;
   std::vector<std::uint8_t> on_boundary(n, 0);
   for (const BoundaryFacet& b : boundary_facets(mesh.solid)) {
-    boundary.add(b.facet.type, b.facet.node.data(), b.facet.n);
+    // The boundary's own graph is needed only when boundary nodes slide.
+    if (options.project) boundary.add(b.facet.type, b.facet.node.data(), b.facet.n);
     for (int i = 0; i < b.facet.n; ++i) on_boundary[b.facet.node[i].v] = 1;
   }
-  const Csr boundary_neighbours = edge_neighbours(n, boundary);
+  const Csr boundary_neighbours = options.project ? edge_neighbours(n, boundary) : Csr{};
   const Csr incident = incident_elements(n, mesh.solid);
 
   auto element_state = [&](std::int32_t e) {
+    const ElemType type = mesh.solid.type[e];
+    if constexpr (Dim == 3) {
+      if (type == ElemType::Tet4) {  // the same numbers without the 8-point copy
+        const VertexId* v = mesh.solid.nodes(ElemId{e});
+        const std::array<Point<3>, 4> p = {mesh.points[v[0].v], mesh.points[v[1].v], mesh.points[v[2].v],
+                                           mesh.points[v[3].v]};
+        const auto [jac, scaled] = jacobians<3>(type, std::span<const Point<3>>(p.data(), 4));
+        return std::pair{jac > 0.0, scaled};
+      }
+    }
     const auto ep = element_points<Dim>(mesh.solid, ElemId{e}, mesh.points);
-    const auto [jac, scaled] = jacobians<Dim>(mesh.solid.type[e], ep.span());
+    const auto [jac, scaled] = jacobians<Dim>(type, ep.span());
     return std::pair{jac > 0.0, scaled};
   };
   // The scaled Jacobians of `state` are those of the current points (before and after).

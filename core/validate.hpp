@@ -64,5 +64,8 @@ template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Di
 /// Euler characteristic of the solid elements alone: V - E + F (2D), V - E + F - C (3D),
 /// V counting only the nodes the solid uses.
 template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh);
+/// The same count by sorting every edge and facet (any element types; the slow twin of the
+/// tetrahedra-only count euler_characteristic uses when it can).
+template <int Dim> long euler_characteristic_ref(const Mesh<Dim>& mesh);
 
 }  // namespace febemesh

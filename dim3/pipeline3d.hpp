@@ -38,7 +38,7 @@ struct Options3d {
   int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
   int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
   int escobar_sweeps = 100;          ///< last-resort untangling sweeps by the Escobar objective (0 = none)
-  int optimize_sweeps = 12;          ///< node-by-node dihedral-angle sweeps after smoothing
+  int optimize_sweeps = 16;          ///< node-by-node dihedral-angle sweeps after smoothing
   double target_dihedral_deg = 30.0; ///< nodes whose tets all reach this angle are left alone
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or

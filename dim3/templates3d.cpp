@@ -42,13 +42,21 @@ struct Builder {
   const SurfacePointFn& surface_point;
   TetMesh out;
   std::map<std::uint64_t, std::int32_t> fan;  // fan centre nodes by lattice point key
+  /// Morton keys of oc.lattice.points (ascending, as the points are): lattice_node compares
+  /// integers instead of recomputing a point's key at every step of the binary search.
+  std::vector<std::uint64_t> keys;
 
   std::int32_t add_point(const P3& p, const BoundaryLocation& w = {}) {
     out.mesh.add_point(p);
     out.where.push_back(w);
     return static_cast<std::int32_t>(out.mesh.points.size() - 1);
   }
-  std::int32_t lattice_node(const LP& p) const { return oc.lattice.find(p); }
+  /// oc.lattice.find(p): the node's index, -1 if p is not a lattice node.
+  std::int32_t lattice_node(const LP& p) const {
+    const std::uint64_t key = point_key<3>(p);
+    const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+    return it != keys.end() && *it == key ? static_cast<std::int32_t>(it - keys.begin()) : -1;
+  }
   std::int32_t fan_node(const LP& p) {
     const std::uint64_t key = point_key<3>(p);
     const auto it = fan.find(key);
@@ -132,7 +140,10 @@ void triangulate_square(const std::array<LP, 4>& q, std::uint32_t len,
 }
 
 TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const SurfacePointFn& surface_point) {
-  Builder b{t, oc, surface_point, {}, {}};
+  Builder b{t, oc, surface_point, {}, {}, {}};
+  b.keys.reserve(oc.lattice.points.size());
+  for (const LP& p : oc.lattice.points) b.keys.push_back(point_key<3>(p));
+  MESH_ASSERT(std::is_sorted(b.keys.begin(), b.keys.end()), "lattice nodes not in key order");
   b.out.mesh.points = oc.points;
   b.out.where = oc.where;
   std::vector<Tri> tris;

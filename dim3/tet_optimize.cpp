@@ -44,6 +44,57 @@ double max_dihedral_cos(const P3& a, const P3& b, const P3& c, const P3& d) {
   return std::clamp(best, -1.0, 1.0);
 }
 
+/// The angle (radians) of a search rank r > 0 (tet_search_rank's 1 - c|c| of its cosine c).
+double rank_angle(double r) {
+  const double cc = 1.0 - r;
+  return std::acos(std::clamp(cc >= 0 ? std::sqrt(cc) : -std::sqrt(-cc), -1.0, 1.0));
+}
+/// The search rank of a positive tetrahedron whose smallest dihedral angle is `angle` radians.
+double angle_rank(double angle) {
+  const double c = std::cos(std::clamp(angle, 0.0, pi));
+  return 1.0 - c * std::abs(c);
+}
+
+/// A tetrahedron seen from one of its nodes, v: the other three in an order that keeps the
+/// orientation with v first, and what does not depend on where v is. rank(x) is
+/// tet_search_rank of the tetrahedron with v at x (the same formula, fewer operations).
+struct MovingTet {
+  P3 q1, q2, q3, n0;   // n0: outward normal of the face opposite v
+  double inv0 = 0.0;   // 1 / |n0|^2, 0 for a zero-area face
+  double l2_fixed = 0.0;  // squared lengths of the three edges away from v
+  void set(const Tet& t, std::int32_t v, const std::vector<P3>& pts) {
+    // Even permutations that bring local node k first.
+    static constexpr int order[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+    const int k = t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : 3;
+    q1 = pts[t[order[k][1]]], q2 = pts[t[order[k][2]]], q3 = pts[t[order[k][3]]];
+    const P3 bc = q2 - q1, bd = q3 - q1, cd = q3 - q2;
+    n0 = bc.cross(bd);
+    const double s0 = n0.squaredNorm();
+    inv0 = s0 > 0 ? 1.0 / s0 : 0.0;
+    l2_fixed = bc.squaredNorm() + bd.squaredNorm() + cd.squaredNorm();
+  }
+  double rank(const P3& x) const {
+    const P3 ab = q1 - x, ac = q2 - x, ad = q3 - x;
+    const P3 n1 = ad.cross(ac), n2 = ab.cross(ad), n3 = ac.cross(ab);
+    const double v6 = -ab.dot(n1);
+    const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + l2_fixed) / 6.0;
+    if (l2 <= 0) return -2.0;
+    if (!(v6 > 0 && 2.0 * v6 * v6 > 1e-18 * l2 * l2 * l2) || !(inv0 > 0))
+      return std::min(std::sqrt(2.0) * v6 / (l2 * std::sqrt(l2)), 0.0) - 1.0;
+    const double s1 = n1.squaredNorm(), s2 = n2.squaredNorm(), s3 = n3.squaredNorm();
+    if (!(s1 > 0 && s2 > 0 && s3 > 0)) return 0.0;
+    const double i1 = 1.0 / s1, i2 = 1.0 / s2, i3 = 1.0 / s3;
+    const auto term = [](double dd, double inv) { return dd * std::abs(dd) * inv; };
+    double best = term(-n0.dot(n1), inv0 * i1);
+    best = std::max(best, term(-n0.dot(n2), inv0 * i2));
+    best = std::max(best, term(-n0.dot(n3), inv0 * i3));
+    best = std::max(best, term(-n1.dot(n2), i1 * i2));
+    best = std::max(best, term(-n1.dot(n3), i1 * i3));
+    best = std::max(best, term(-n2.dot(n3), i2 * i3));
+    return 1.0 - std::clamp(best, -1.0, 1.0);
+  }
+};
+
 struct Optimizer {
   Mesh<3>& mesh;
   std::vector<BoundaryLocation>& where;
@@ -54,6 +105,12 @@ struct Optimizer {
   std::vector<std::array<std::int32_t, 3>> faces;  // interface triangles
   std::vector<std::int32_t> f_start, f_incident;   // CSR node -> interface triangles
   std::vector<P3> node_normal;                     // surface normal at each surface node
+  /// The search rank of every tetrahedron at the current points: tet_search_rank at the
+  /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
+  std::vector<double> tet_q;
+  double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
+  std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
+  std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
 
   /// Search quality of interface triangle f with node v at x (normal nx there): +inf when it
   /// is aligned with the surface, else like an inverted tetrahedron (-1 + cosine, in [-2, -1]).
@@ -78,7 +135,7 @@ struct Optimizer {
   double quality_at(std::int32_t t, std::int32_t v, const P3& x) const {
     std::array<P3, 4> p;
     for (int k = 0; k < 4; ++k) p[k] = tets[t][k] == v ? x : mesh.points[tets[t][k]];
-    return tet_search_quality(p[0], p[1], p[2], p[3]);
+    return tet_search_rank(p[0], p[1], p[2], p[3]);
   }
   double worst_at(std::int32_t v, const P3& x, std::int32_t* which = nullptr) const {
     double w = std::numeric_limits<double>::infinity();
@@ -92,24 +149,47 @@ struct Optimizer {
     return w;
   }
   /// Like worst_at, but stops as soon as one tetrahedron is at or below `bound` (the answer
-  /// is then some value <= bound).
-  double worst_above(std::int32_t v, const P3& x, double bound) const {
+  /// is then some value <= bound). The incident tetrahedron `first` (an index into them, the one
+  /// likeliest to fail) is tried first and becomes the one that failed; the order changes only
+  /// which value <= bound is returned, never whether one is.
+  double worst_above(std::int32_t v, const P3& x, double bound, std::int32_t& first) const {
+    const std::int32_t n = start[v + 1] - start[v];
     double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
-      w = std::min(w, quality_at(incident[k], v, x));
-      if (w <= bound) return w;
+    for (std::int32_t j = 0; j < n; ++j) {
+      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
+      w = std::min(w, quality_at(incident[start[v] + i], v, x));
+      if (w <= bound) {
+        first = i;
+        return w;
+      }
     }
     return w;
   }
-  P3 gradient(std::int32_t t, std::int32_t v, const P3& x, double h) const {
+  static P3 gradient(const MovingTet& m, const P3& x, double h) {
     P3 g;
     for (int d = 0; d < 3; ++d) {
       P3 xp = x, xm = x;
       xp[d] += h;
       xm[d] -= h;
-      g[d] = (quality_at(t, v, xp) - quality_at(t, v, xm)) / (2 * h);
+      g[d] = (m.rank(xp) - m.rank(xm)) / (2 * h);
     }
     return g;
+  }
+  /// worst_above over `local` (relax's incident tetrahedra).
+  /// Without an early stop, trial[i] holds every incident tetrahedron's rank at x.
+  double local_worst_above(const P3& x, double bound, std::int32_t& first) {
+    const std::int32_t n = static_cast<std::int32_t>(local.size());
+    double w = std::numeric_limits<double>::infinity();
+    for (std::int32_t j = 0; j < n; ++j) {
+      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
+      trial[i] = local[i].rank(x);
+      w = std::min(w, trial[i]);
+      if (w <= bound) {
+        first = i;
+        return w;
+      }
+    }
+    return w;
   }
   /// Escobar et al.'s untangling objective of tetrahedron t with v at x: |S|^2 / (3 h(s)^(2/3)),
   /// S its Jacobian against the regular tetrahedron of edge `scale`, s = det S and
@@ -209,6 +289,22 @@ struct Optimizer {
     w_out = w;
     return true;
   }
+  /// CSR node -> neighbour nodes (those sharing a tetrahedron), ascending.
+  void build_neighbours() {
+    const std::size_t n = mesh.points.size();
+    nb_start.assign(n + 1, 0);
+    std::vector<std::int32_t> tmp;
+    for (std::size_t v = 0; v < n; ++v) {
+      tmp.clear();
+      for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
+        for (std::int32_t u : tets[incident[k]])
+          if (u != static_cast<std::int32_t>(v)) tmp.push_back(u);
+      std::sort(tmp.begin(), tmp.end());
+      tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
+      nbs.insert(nbs.end(), tmp.begin(), tmp.end());
+      nb_start[v + 1] = static_cast<std::int32_t>(nbs.size());
+    }
+  }
   bool is_surface(std::int32_t v) const {
     return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0;
   }
@@ -221,51 +317,62 @@ struct Optimizer {
   /// One local search at node v; returns true if it moved.
   bool relax(std::int32_t v) {
     const P3 x0 = mesh.points[v];
-    std::int32_t worst_tet = -1;
+    std::int32_t worst_local = 0;
     const bool surf = is_surface(v);
     const bool guard = surf && !f_start.empty();
-    const double f0 = std::min(worst_at(v, x0, &worst_tet), guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
-    if (opt.untangle_only ? f0 > 0 : f0 >= opt.target_dihedral_deg * pi / 180.0) return false;
+    double tets_worst = std::numeric_limits<double>::infinity();
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
+      if (tet_q[incident[k]] < tets_worst) tets_worst = tet_q[incident[k]], worst_local = k - start[v];
+    const double f0 = std::min(tets_worst, guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
+    if (opt.untangle_only ? f0 > 0 : f0 >= target_rank) return false;
     double len = 0.0;
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) len += (mesh.points[nbs[k]] - x0).norm();
     len /= std::max<std::int32_t>(1, nb_start[v + 1] - nb_start[v]);
     if (len <= 0) return false;
     const double h = 1e-4 * len;
 
-    std::vector<P3> dirs;
-    const P3 g = gradient(worst_tet, v, x0, h);
-    if (g.norm() > 0) dirs.push_back(g.normalized());
+    local.resize(static_cast<std::size_t>(start[v + 1] - start[v]));
+    trial.resize(local.size());
+    best_ranks.resize(local.size());
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) local[k - start[v]].set(tets[incident[k]], v, mesh.points);
+    std::array<P3, 2> dirs;
+    int n_dirs = 0;
+    const P3 g = gradient(local[worst_local], x0, h);
+    if (g.norm() > 0) dirs[n_dirs++] = g.normalized();
     P3 sum = P3::Zero();
-    const double margin = f0 <= 0 ? 0.0 : 0.02;
+    // The nearly worst: within 0.02 rad of the worst angle.
+    const double near = f0 <= 0 ? f0 : angle_rank(rank_angle(f0) + 0.02);
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
       const std::int32_t t = incident[k];
-      const double q = quality_at(t, v, x0);
-      if (q <= f0 + margin || (f0 <= 0 && q <= 0)) {
-        const P3 gt = gradient(t, v, x0, h);
+      const double q = tet_q[t];
+      if (q <= near || (f0 <= 0 && q <= 0)) {
+        const P3 gt = gradient(local[k - start[v]], x0, h);
         if (gt.norm() > 0) sum += gt.normalized();
       }
     }
-    if (sum.norm() > 0) dirs.push_back(sum.normalized());
+    if (sum.norm() > 0) dirs[n_dirs++] = sum.normalized();
 
-    std::vector<P3> cands;
+    std::array<P3, 10> cands;
+    int n_cands = 0;
     P3 centroid = P3::Zero();
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) centroid += mesh.points[nbs[k]];
     centroid /= std::max<std::int32_t>(1, nb_start[v + 1] - nb_start[v]);
-    cands.push_back(centroid);
-    cands.push_back(0.5 * (centroid + x0));
-    for (const P3& d : dirs)
-      for (double s : {0.25, 0.08, 0.025, 0.006}) cands.push_back(x0 + s * len * d);
+    cands[n_cands++] = centroid;
+    cands[n_cands++] = 0.5 * (centroid + x0);
+    for (int i = 0; i < n_dirs; ++i)
+      for (double s : {0.25, 0.08, 0.025, 0.006}) cands[n_cands++] = x0 + s * len * dirs[i];
 
     double best = f0;
     P3 best_x = x0;
     BoundaryLocation best_w = surf ? where[v] : BoundaryLocation{};
-    for (const P3& c : cands) {
+    for (int i = 0; i < n_cands; ++i) {
+      const P3& c = cands[i];
       P3 x = c;
       BoundaryLocation w;
       if (surf) std::tie(x, w) = opt.project(c);
-      double f = worst_above(v, x, best + 1e-12);
+      double f = local_worst_above(x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
-      if (f > best + 1e-12) best = f, best_x = x, best_w = w;
+      if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }
     if (opt.untangle_only && opt.escobar && !(best > 0) && (!surf || opt.escobar_surface)) {
       // The max-min candidates did not untangle this node's tetrahedra: descend the smooth
@@ -273,10 +380,16 @@ struct Optimizer {
       P3 ex;
       BoundaryLocation ew;
       const P3 from = best_x;
-      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) best_x = ex, best_w = ew;
+      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) {
+        best_x = ex, best_w = ew;
+        for (std::size_t k = 0; k < local.size(); ++k) best_ranks[k] = local[k].rank(ex);
+      }
     }
     if (best_x == x0) return false;
     mesh.points[v] = best_x;
+    // The ranks at the new point were computed for the accepted candidate (all of them: it
+    // was not stopped early).
+    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) tet_q[incident[k]] = best_ranks[k - start[v]];
     if (surf) where[v] = best_w;
     if (guard) node_normal[v] = opt.surface_normal(best_w);
     return true;
@@ -284,6 +397,35 @@ struct Optimizer {
 };
 
 }  // namespace
+
+double tet_search_rank(const P3& a, const P3& b, const P3& c, const P3& d) {
+  const P3 ab = b - a, ac = c - a, ad = d - a;
+  const P3 bc = c - b, bd = d - b, cd = d - c;
+  // Outward (for positive orientation) face normals opposite a, b, c, d.
+  const P3 n0 = bc.cross(bd), n1 = ad.cross(ac), n2 = ab.cross(ad), n3 = ac.cross(ab);
+  const double v6 = -ab.dot(n1);
+  const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + bc.squaredNorm() + bd.squaredNorm() +
+                     cd.squaredNorm()) /
+                    6.0;
+  if (l2 <= 0) return -2.0;
+  // Mean ratio sqrt2 v6 / l2^1.5 > 1e-9 without the root: 2 v6^2 > 1e-18 l2^3.
+  if (!(v6 > 0 && 2.0 * v6 * v6 > 1e-18 * l2 * l2 * l2)) return std::min(std::sqrt(2.0) * v6 / (l2 * std::sqrt(l2)), 0.0) - 1.0;
+  const std::array<P3, 4> n = {n0, n1, n2, n3};
+  std::array<double, 4> inv{};
+  for (int i = 0; i < 4; ++i) {
+    const double s = n[i].squaredNorm();
+    if (!(s > 0)) return 0.0;  // a zero-area face: cosine 1
+    inv[i] = 1.0 / s;
+  }
+  // The largest c|c| over the six edges, c = -n_i.n_j / (|n_i| |n_j|): no root, no acos.
+  double best = -1.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) {
+      const double dd = -n[i].dot(n[j]);
+      best = std::max(best, dd * std::abs(dd) * inv[i] * inv[j]);
+    }
+  return 1.0 - std::clamp(best, -1.0, 1.0);
+}
 
 double tet_search_quality(const P3& a, const P3& b, const P3& c, const P3& d) {
   const double r = mean_ratio_volume(a, b, c, d);
@@ -302,7 +444,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}, {}, {}};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -319,21 +461,6 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     for (std::size_t t = 0; t < o.tets.size(); ++t)
       for (std::int32_t v : o.tets[t]) o.incident[fill[v]++] = static_cast<std::int32_t>(t);
   }
-  o.nb_start.assign(n + 1, 0);
-  {
-    std::vector<std::int32_t> tmp;
-    for (std::size_t v = 0; v < n; ++v) {
-      tmp.clear();
-      for (std::int32_t k = o.start[v]; k < o.start[v + 1]; ++k)
-        for (std::int32_t u : o.tets[o.incident[k]])
-          if (u != static_cast<std::int32_t>(v)) tmp.push_back(u);
-      std::sort(tmp.begin(), tmp.end());
-      tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
-      o.nbs.insert(o.nbs.end(), tmp.begin(), tmp.end());
-      o.nb_start[v + 1] = static_cast<std::int32_t>(o.nbs.size());
-    }
-  }
-
   if (opt.surface_normal && opt.project) {
     o.node_normal.assign(n, P3::Zero());
     for (std::size_t v = 0; v < n && v < where.size(); ++v)
@@ -359,43 +486,60 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   };
 
   TetOptimizeStats st;
+  // Inverted tetrahedra and the smallest dihedral angle, from the ranks (one acos).
   const auto measure = [&](std::size_t& inverted, double& min_deg) {
     inverted = 0;
-    min_deg = 180.0;
-    for (const Tet& t : o.tets) {
-      const P3 &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]], &d = mesh.points[t[3]];
-      const double q = tet_search_quality(a, b, c, d);
-      if (q < 0) {
-        ++inverted;
-        min_deg = 0.0;
-      } else {
-        min_deg = std::min(min_deg, q * 180.0 / pi);
-      }
+    double lo = std::numeric_limits<double>::infinity();
+    for (const double q : o.tet_q) {
+      inverted += q < 0 ? 1 : 0;
+      lo = std::min(lo, q);
     }
+    min_deg = inverted > 0 ? 0.0 : o.tet_q.empty() ? 180.0 : rank_angle(lo) * 180.0 / pi;
   };
-  measure(st.inverted_before, st.min_dihedral_before_deg);
-  st.folded_before = count_folded();
-
   // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
   const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
   std::vector<std::uint8_t> active(n, 0);
-  for (const Tet& t : o.tets) {
-    const double q = tet_search_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
-    if (opt.untangle_only ? q <= 0 : q < target)
+  o.tet_q.resize(o.tets.size());
+  o.target_rank = angle_rank(target);
+  bool any_active = false;
+  for (std::size_t i = 0; i < o.tets.size(); ++i) {
+    const Tet& t = o.tets[i];
+    const double q = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+    o.tet_q[i] = q;
+    if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
+      any_active = true;
       for (std::int32_t v : t) active[v] = 1;
+    }
   }
-  for (std::size_t f = 0; f < o.faces.size(); ++f)
-    if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0)
-      for (std::int32_t v : o.faces[f]) active[v] = 1;
+  measure(st.inverted_before, st.min_dihedral_before_deg);
+  st.folded_before = count_folded();
+  if (st.folded_before > 0) {
+    any_active = true;
+    for (std::size_t f = 0; f < o.faces.size(); ++f)
+      if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0)
+        for (std::int32_t v : o.faces[f]) active[v] = 1;
+  }
+  if (!any_active) {  // nothing below the target: one empty sweep, no node graph needed
+    st.sweeps = opt.max_sweeps > 0 ? 1 : 0;
+    st.inverted_after = st.inverted_before, st.min_dihedral_after_deg = st.min_dihedral_before_deg;
+    st.folded_after = st.folded_before;
+    return st;
+  }
+  o.build_neighbours();
+  // stale[v]: v or a neighbour moved since v's last local search. A search that did not move
+  // v, repeated with the same numbers, does not move it either: such nodes are skipped (the
+  // moves, and so the mesh, are those of searching them again).
+  std::vector<std::uint8_t> stale(n, 1), next(n, 0);
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
-    std::vector<std::uint8_t> next(n, 0);
+    std::fill(next.begin(), next.end(), 0);
     std::size_t moved = 0;
     for (std::size_t v = 0; v < n; ++v) {
-      if (!active[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+      if (!active[v] || !stale[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+      stale[v] = 0;
       if (!o.relax(static_cast<std::int32_t>(v))) continue;
       ++moved;
-      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1;
-      next[v] = 1;
+      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1, stale[o.nbs[k]] = 1;
+      next[v] = 1, stale[v] = 1;
     }
     st.sweeps = sweep + 1;
     st.moves += moved;

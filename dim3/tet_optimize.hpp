@@ -62,6 +62,11 @@ struct TetOptimizeStats {
 /// else (signed mean ratio) - 1 <= -1.
 double tet_search_quality(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
 
+/// What the search compares: ordered like tet_search_quality and of the same sign, without
+/// acos or roots for positive tetrahedra: 1 - c|c| in [0, 2], c the cosine of the smallest
+/// dihedral angle; inverted and flat ones as tet_search_quality (<= -1).
+double tet_search_rank(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
+
 /// Smallest dihedral angle of a tetrahedron in degrees (0 when flat); sign-free.
 double tet_min_dihedral_deg(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
 

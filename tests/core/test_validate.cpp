@@ -222,3 +222,53 @@ TEST_CASE("validation of a large grid is fast enough", "[validate]") {
   CHECK(r.valid);
   CHECK(r.euler == 1);
 }
+
+namespace {
+
+/// The Kuhn tetrahedra (six per cell) of an n^3 grid of unit cells, those whose index `keep`
+/// accepts; ids of the (n+1)^3 grid nodes, unused ones included.
+template <class Keep> Mesh<3> kuhn_cube(int n, Keep&& keep) {
+  Mesh<3> m;
+  const int p = n + 1;
+  auto id = [&](int i, int j, int k) { return (k * p + j) * p + i; };
+  for (int k = 0; k < p; ++k)
+    for (int j = 0; j < p; ++j)
+      for (int i = 0; i < p; ++i) m.points.push_back(Point<3>(i, j, k));
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  std::size_t index = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& perm : perms) {
+          if (!keep(index++)) continue;
+          int c[3] = {i, j, k};
+          std::array<VertexId, 4> t;
+          t[0] = VertexId{id(c[0], c[1], c[2])};
+          for (int s = 0; s < 3; ++s) {
+            ++c[perm[s]];
+            t[s + 1] = VertexId{id(c[0], c[1], c[2])};
+          }
+          m.solid.add(ElemType::Tet4, t.data(), 4);
+        }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("euler_characteristic of tetrahedra agrees with its sorting twin", "[validate]") {
+  CHECK(euler_characteristic(kuhn_cube(3, [](std::size_t) { return true; })) == 1);
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    std::uint64_t s = seed;
+    const double fraction = 0.2 + 0.04 * seed;
+    const Mesh<3> m = kuhn_cube(4, [&](std::size_t) {
+      s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+      return double(s >> 11) / double(1ULL << 53) < fraction;
+    });
+    CAPTURE(seed);
+    CHECK(euler_characteristic(m) == euler_characteristic_ref(m));
+  }
+  // A tetrahedron with a repeated node: the general count.
+  Mesh<3> bad = kuhn_cube(1, [](std::size_t i) { return i == 0; });
+  bad.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{1}, VertexId{1}, VertexId{7}});
+  CHECK(euler_characteristic(bad) == euler_characteristic_ref(bad));
+}

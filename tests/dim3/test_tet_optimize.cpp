@@ -1,0 +1,127 @@
+// tet_optimize: the search rank (no acos) orders tetrahedra like the angle-based search quality
+// (its slow twin) and has its sign; the optimiser never lowers the worst dihedral angle or
+// inverts a tetrahedron, and gives the same mesh when run twice.
+
+#include <catch2/catch.hpp>
+#include <rapidcheck.h>
+
+#include <cmath>
+
+#include "core/mesh.hpp"
+#include "dim3/tet_optimize.hpp"
+#include "property.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim3;
+
+namespace {
+
+using P3 = Point<3>;
+
+rc::Gen<P3> gen_point() {
+  return rc::gen::map(rc::gen::tuple(rc::gen::inRange(-1000, 1001), rc::gen::inRange(-1000, 1001),
+                                     rc::gen::inRange(-1000, 1001)),
+                      [](const std::tuple<int, int, int>& t) {
+                        return P3(std::get<0>(t) / 1000.0, std::get<1>(t) / 1000.0, std::get<2>(t) / 1000.0);
+                      });
+}
+
+/// A jittered cube of 5^3 nodes cut into six tetrahedra per cell (Kuhn), all positive.
+Mesh<3> jittered_cube(double jitter, unsigned seed) {
+  Mesh<3> m;
+  const int n = 5;
+  auto id = [&](int i, int j, int k) { return (k * n + j) * n + i; };
+  std::uint64_t s = seed;
+  auto rnd = [&] {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(s >> 11) / double(1ULL << 53) - 0.5;
+  };
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const bool inner = i > 0 && j > 0 && k > 0 && i < n - 1 && j < n - 1 && k < n - 1;
+        P3 p(i, j, k);
+        if (inner) p += jitter * P3(rnd(), rnd(), rnd());
+        m.points.push_back(p);
+      }
+  // Kuhn: the six paths 0 -> 7 along the cube's edges.
+  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k + 1 < n; ++k)
+    for (int j = 0; j + 1 < n; ++j)
+      for (int i = 0; i + 1 < n; ++i)
+        for (const auto& p : perms) {
+          int c[3] = {i, j, k};
+          std::array<VertexId, 4> t;
+          t[0] = VertexId{id(c[0], c[1], c[2])};
+          for (int s2 = 0; s2 < 3; ++s2) {
+            ++c[p[s2]];
+            t[s2 + 1] = VertexId{id(c[0], c[1], c[2])};
+          }
+          const P3 &a = m.points[t[0].v], &b = m.points[t[1].v], &cc = m.points[t[2].v], &d = m.points[t[3].v];
+          if ((b - a).dot((cc - a).cross(d - a)) < 0) std::swap(t[2], t[3]);
+          m.solid.add(ElemType::Tet4, t.data(), 4);
+        }
+  return m;
+}
+
+double min_dihedral(const Mesh<3>& m) {
+  double lo = 180.0;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const double q = tet_search_quality(m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]);
+    lo = std::min(lo, q < 0 ? 0.0 : q * 180.0 / 3.14159265358979323846);
+  }
+  return lo;
+}
+
+}  // namespace
+
+TEST_CASE("tet_search_rank has the sign of tet_search_quality and its order", "[tet_optimize][property]") {
+  test::prop("sign and order", 300, [] {
+    const auto p = *rc::gen::container<std::vector<P3>>(8, gen_point());
+    const double q1 = tet_search_quality(p[0], p[1], p[2], p[3]), r1 = tet_search_rank(p[0], p[1], p[2], p[3]);
+    const double q2 = tet_search_quality(p[4], p[5], p[6], p[7]), r2 = tet_search_rank(p[4], p[5], p[6], p[7]);
+    RC_ASSERT((q1 < 0) == (r1 < 0));
+    RC_ASSERT((q1 > 0) == (r1 > 0));
+    if (q1 < 0) RC_ASSERT(r1 == q1);  // inverted and flat ones: the same value
+    // Positive ones: the same order unless the two angles agree to rounding.
+    if (q1 > 0 && q2 > 0 && std::abs(q1 - q2) > 1e-9) RC_ASSERT((q1 < q2) == (r1 < r2));
+  });
+}
+
+TEST_CASE("tet_search_rank of known tetrahedra", "[tet_optimize]") {
+  const P3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), d(0, 0, 1);
+  // The corner tetrahedron: smallest dihedral angle acos(1/sqrt3) (at the slanted face's edges).
+  const double angle = std::acos(1.0 / std::sqrt(3.0));
+  CHECK(tet_search_quality(a, b, c, d) == Approx(angle));
+  const double cs = std::cos(angle);
+  CHECK(tet_search_rank(a, b, c, d) == Approx(1.0 - cs * cs));
+  CHECK(tet_search_rank(a, c, b, d) < -1.0);  // inverted
+  CHECK(tet_search_rank(a, b, P3(2, 0, 0), d) <= -1.0);  // flat
+}
+
+TEST_CASE("optimize_tets raises the worst dihedral angle, inverts nothing, is repeatable", "[tet_optimize]") {
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    Mesh<3> m = jittered_cube(0.6, seed);
+    const double before = min_dihedral(m);
+    std::vector<BoundaryLocation> where(m.points.size());
+    TetOptimizeOptions opt;
+    opt.max_sweeps = 16;
+    // The cube's boundary nodes stay put (no surface projection here).
+    opt.fixed.assign(m.points.size(), 0);
+    for (std::size_t v = 0; v < m.points.size(); ++v) {
+      const P3& p = m.points[v];
+      opt.fixed[v] = p.minCoeff() == 0.0 || p.maxCoeff() == 4.0 ? 1 : 0;
+    }
+    Mesh<3> again = m;
+    std::vector<BoundaryLocation> where2 = where;
+    const TetOptimizeStats st = optimize_tets(m, where, opt);
+    optimize_tets(again, where2, opt);
+    CAPTURE(seed, before, st.min_dihedral_after_deg);
+    CHECK(st.inverted_after == 0);
+    CHECK(st.moves > 0);
+    CHECK(min_dihedral(m) > before);
+    CHECK(st.min_dihedral_after_deg == Approx(min_dihedral(m)).margin(1e-6));
+    CHECK(m.points == again.points);
+  }
+}
