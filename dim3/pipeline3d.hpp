@@ -55,6 +55,17 @@ struct Options3d {
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).
   int topology_refinements = 2;
+  /// Refinements around the octants dropped as islands, before the boundary octants are built:
+  /// every leaf within `island_cells` of their size of an island octant is split, so that the
+  /// thin part they sit in (elephant's legs, trunk, tail at level 4) gets interior octants that
+  /// reach the rest. Not counted in max_repairs; trees without islands are untouched.
+  int island_refinements = 3;
+  double island_cells = 2.0;
+  /// With an island refinement, also split the octants on the surface whose triangles are
+  /// thinner (SurfaceBoundary::thickness) than this x their size; 0 = off.
+  double thin_cells = 1.5;
+  /// No island refinement when it would split more than this share of the leaves.
+  double island_max_fraction = 0.12;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
