@@ -29,6 +29,17 @@ struct Options3d {
   /// When the run with the buffer rule fails, run once more without it (Result3d::buffer_dropped).
   bool retry_without_buffer = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
+  /// When the untangling leaves inverted tets or folded interface triangles, drop the interior
+  /// octants at the lattice nodes behind them (thicker boundary octants) up to this many times
+  /// per tree before refining around them.
+  int peel_rounds = 0;
+  /// When the untangling leaves folded interface triangles but no inverted tetrahedron, smooth
+  /// and keep the mesh if the validator accepts it, else refine around the folds.
+  bool accept_valid_folds = false;
+  /// When every other try fails, run once more without the buffer rule, with projections that
+  /// leave through every free face of their node and land on surface facing it (min_outward and
+  /// min_facing 0.3, outward_all_faces) and accept_valid_folds (Result3d::facing_projection).
+  bool retry_facing = true;
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
   /// Projection admissibility (BoundaryOctantOptions min_outward, min_facing, outward_all_faces).
   double min_outward = -1.0;
@@ -44,6 +55,17 @@ struct Options3d {
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).
   int topology_refinements = 2;
+  /// Refinements around the octants dropped as islands, before the boundary octants are built:
+  /// every leaf within `island_cells` of their size of an island octant is split, so that the
+  /// thin part they sit in (elephant's legs, trunk, tail at level 4) gets interior octants that
+  /// reach the rest. Not counted in max_repairs; trees without islands are untouched.
+  int island_refinements = 3;
+  double island_cells = 2.0;
+  /// With an island refinement, also split the octants on the surface whose triangles are
+  /// thinner (SurfaceBoundary::thickness) than this x their size; 0 = off.
+  double thin_cells = 1.5;
+  /// No island refinement when it would split more than this share of the leaves.
+  double island_max_fraction = 0.12;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
@@ -68,6 +90,7 @@ struct Result3d {
   int n_repairs = 0;
   bool buffer_dropped = false;       ///< the run with the buffer rule failed; this one is without
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
+  bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
@@ -81,7 +104,8 @@ using Progress3 = std::function<void(const std::string&)>;
 /// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
 /// LimitError when the tree would exceed max_cells. `s` gets the options' levels. When it fails
 /// with feature snapping it runs once more without (Result3d::features_dropped); when both fail
-/// with the buffer rule, the two once more without it (Result3d::buffer_dropped).
+/// with the buffer rule, the two once more without it (Result3d::buffer_dropped); when all
+/// fail, those without the buffer once more with facing projections (Options3d::retry_facing).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 }  // namespace febemesh::dim3

@@ -66,22 +66,26 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
   // octants across it.
   if (options_.thickness_cells > 0) {
     for (std::int32_t t = 0; t < nt; ++t) {
-      const P3 n = surface_.normal(t).normalized();
-      const P3 from = centroid[t] - 1e-9 * diagonal_ * n, to = centroid[t] - diagonal_ * n;
-      double best = std::numeric_limits<double>::infinity();
-      tree_.for_each_on_segment(from, to, [&](std::int32_t u) {
-        if (u == t) return;
-        const auto& q = tree_.points(u);
-        const double s = line_triangle_parameter(from, to, q[0], q[1], q[2]);
-        if (s > 0 && s < best) best = s;
-      });
-      if (std::isfinite(best) && best > 0) {
-        const double thickness = best * diagonal_;
-        curvature_level_[t] =
-            std::max(curvature_level_[t], std::log2(root_side * options_.thickness_cells / thickness));
-      }
+      const double thick = thickness(t);
+      if (std::isfinite(thick) && thick > 0)
+        curvature_level_[t] = std::max(curvature_level_[t], std::log2(root_side * options_.thickness_cells / thick));
     }
   }
+}
+
+double SurfaceBoundary::thickness(std::int32_t t) const {
+  const Triangle& tr = surface_.triangle(t);
+  const P3 centroid = (surface_.vertex(tr[0]) + surface_.vertex(tr[1]) + surface_.vertex(tr[2])) / 3.0;
+  const P3 n = surface_.normal(t).normalized();
+  const P3 from = centroid - 1e-9 * diagonal_ * n, to = centroid - diagonal_ * n;
+  double best = std::numeric_limits<double>::infinity();
+  tree_.for_each_on_segment(from, to, [&](std::int32_t u) {
+    if (u == t) return;
+    const auto& q = tree_.points(u);
+    const double s = line_triangle_parameter(from, to, q[0], q[1], q[2]);
+    if (s > 0 && s < best) best = s;
+  });
+  return std::isfinite(best) && best > 0 ? best * diagonal_ : std::numeric_limits<double>::infinity();
 }
 
 SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptions options) {

@@ -70,6 +70,9 @@ class SurfaceBoundary final : public Boundary<3> {
   void set_max_level(double level) { options_.max_level = level; }
   double global_level() const { return options_.global_level; }
   double max_level() const { return options_.max_level; }
+  /// Thickness of the solid behind triangle t: the distance from its centroid straight inwards
+  /// to the next surface point (infinity when the ray meets nothing).
+  double thickness(std::int32_t t) const;
   /// Curvature level of triangle t (before the global level and the cap).
   double curvature_level(std::int32_t t) const { return curvature_level_[t]; }
 

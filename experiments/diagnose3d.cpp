@@ -72,6 +72,16 @@ int main(int argc, char** argv) {
   opt.outward_all_faces = bo.outward_all_faces;
   opt.projection_rays = bo.rays;
   for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--accept-folds") opt.accept_valid_folds = true;
+  for (int i = 1; i + 1 < argc; ++i) {
+    if (std::string(argv[i]) == "--peel-rounds") opt.peel_rounds = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--buffer") opt.buffer = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--max-repairs") opt.max_repairs = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--island-refinements") opt.island_refinements = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--island-cells") opt.island_cells = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--thin-cells") opt.thin_cells = std::atof(argv[i + 1]);
+  }
+  for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--pipeline") {
       const auto t0 = std::chrono::steady_clock::now();
       std::string verdict = "valid";
