@@ -31,6 +31,10 @@
 // session 6 (fandisk meshed through all five tries, elephant refused without the last): 179 s
 // wall / 109 s CPU on the shared 2-core machine (264 s / 132 s with elephant's last try too);
 // session 7 (elephant valid, its run without the buffer rule directly): 243 s wall.
+// After merging the faster dihedral optimiser (2026-12-02, CLI --threads 1): sphere966 L4/L5
+// 28.17/27.67 deg, spool L4 9.66 deg, anchor L4 276042 tets 8.29 deg 0.59%, fandisk L4 180486
+// tets 11.50 deg 2.03% (4 repairs), elephant L4 1168938 tets 1.10 deg 0.31%, 148 s CPU; the
+// [data] run 155-161 s wall.
 
 #include <catch2/catch.hpp>
 
