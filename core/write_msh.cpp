@@ -12,18 +12,17 @@
 #include <type_traits>
 
 #include "core/error.hpp"
+#include "core/spill_buffer.hpp"
 
 namespace febemesh {
 
 namespace {
 
-/// Appends text to a string and, when given a file, spills it in chunks of a few MiB.
-class Sink {
+/// MSH fields as text or bytes; with a file it spills every few MiB (SpillBuffer).
+class Sink : public SpillBuffer {
  public:
   explicit Sink(bool binary, std::FILE* file = nullptr, std::string path = {})
-      : binary_(binary), file_(file), path_(std::move(path)) {
-    buf_.reserve(file_ ? 2 * chunk : 1 << 16);
-  }
+      : SpillBuffer(file, std::move(path), file ? 2 * chunk : 1 << 16), binary_(binary) {}
   bool binary() const { return binary_; }
   /// The bytes of a trivially copyable value (the writer runs on little-endian hosts only).
   template <class T> void raw(const T& v) {
@@ -62,35 +61,16 @@ class Sink {
     return *this;
   }
   template <class Int> Sink& integer(Int v) {
-    char tmp[24];
-    const auto res = std::to_chars(tmp, tmp + sizeof tmp, v);
-    buf_.append(tmp, static_cast<std::size_t>(res.ptr - tmp));
+    append_number(v);
     return *this;
   }
   Sink& real(double v) {
-    char tmp[32];
-    const auto res = std::to_chars(tmp, tmp + sizeof tmp, v);
-    buf_.append(tmp, static_cast<std::size_t>(res.ptr - tmp));
+    append_number(v);
     return *this;
   }
-  void maybe_flush() {
-    if (file_ && buf_.size() >= chunk) flush();
-  }
-  void flush() {
-    if (file_ && !buf_.empty()) {
-      if (std::fwrite(buf_.data(), 1, buf_.size(), file_) != buf_.size())
-        throw InputError("cannot write " + path_ + ": " + std::strerror(errno));
-      buf_.clear();
-    }
-  }
-  std::string take() { return std::move(buf_); }
 
  private:
-  static constexpr std::size_t chunk = 4 << 20;
   bool binary_;
-  std::FILE* file_;
-  std::string path_;
-  std::string buf_;
 };
 
 template <int Dim> void bbox_line(Sink& out, const Mesh<Dim>& mesh, const Elements& els) {

@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "core/error.hpp"
+#include "core/spill_buffer.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
 
@@ -17,41 +18,20 @@ namespace febemesh {
 
 namespace {
 
-/// Text built with std::to_chars; with a file it spills every few MiB, so the whole text is
-/// never held (it was the CLI's memory peak).
-class Text {
+/// Text built with std::to_chars; with a file it spills every few MiB (SpillBuffer).
+class Text : public SpillBuffer {
  public:
-  explicit Text(std::FILE* file = nullptr, std::string path = {}) : file_(file), path_(std::move(path)) {
-    if (file_) buf_.reserve(chunk + (1 << 16));
-  }
+  explicit Text(std::FILE* file = nullptr, std::string path = {})
+      : SpillBuffer(file, std::move(path), file ? chunk + (1 << 16) : 0) {}
   Text& operator<<(std::string_view s) {
     buf_.append(s);
     return *this;
   }
   template <class Num> Text& num(Num v) {
-    char tmp[32];
-    const auto res = std::to_chars(tmp, tmp + sizeof tmp, v);
-    buf_.append(tmp, static_cast<std::size_t>(res.ptr - tmp));
+    append_number(v);
     buf_.push_back(' ');
     return *this;
   }
-  void maybe_flush() {
-    if (file_ && buf_.size() >= chunk) flush();
-  }
-  void flush() {
-    if (file_ && !buf_.empty()) {
-      if (std::fwrite(buf_.data(), 1, buf_.size(), file_) != buf_.size())
-        throw InputError("cannot write " + path_ + ": " + std::strerror(errno));
-      buf_.clear();
-    }
-  }
-  std::string take() { return std::move(buf_); }
-
- private:
-  static constexpr std::size_t chunk = 4 << 20;
-  std::FILE* file_;
-  std::string path_;
-  std::string buf_;
 };
 
 /// VTK's node order from Gmsh's: only the wedge differs (VTK's first triangle faces away from
