@@ -113,10 +113,7 @@ int run(const std::vector<std::string>& argv) {
 
   progress("validating " + std::to_string(mesh.solid.size()) + " tetrahedra");
   const auto tv = std::chrono::steady_clock::now();
-  ValidateOptions<3> vo;
-  if (surface.euler_characteristic() % 2 == 0) vo.expected_euler = surface.euler_characteristic() / 2;
-  vo.boundary_distance = [&](const Point<3>& p) { return surface.closest_point(p).distance; };
-  vo.boundary_tolerance = 1e-10 * surface.bounding_box().extent().norm();
+  const ValidateOptions<3> vo = dim3::surface_validation(surface);
   const ValidationReport vr = validate(mesh, vo);
   const QualitySummary q = summarize_quality(mesh);
   const dim3::Fidelity3d fid = dim3::measure_fidelity(opt.hex_dominant ? triangulated_interface(mesh) : mesh, surface);

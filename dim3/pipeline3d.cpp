@@ -288,6 +288,14 @@ Result3d mesh3d_buffer(SurfaceBoundary& s, const Options3d& opt, const Progress3
 
 }  // namespace
 
+ValidateOptions<3> surface_validation(const SurfaceBoundary& s) {
+  ValidateOptions<3> vo;
+  if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
+  vo.boundary_distance = [&s](const Point<3>& p) { return s.closest_point(p).distance; };
+  vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
+  return vo;
+}
+
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   const auto buffer = [&](const Options3d& o) { return mesh3d_buffer(s, o, progress); };
   if (!opt.retry_facing) return buffer(opt);
@@ -531,11 +539,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         // Folded interface triangles where the surface's normals at their nodes disagree (the
         // two sheets of a lip thinner than the octants): the fold test has no reference there.
         // The mesh stands if it is valid (conforming, interface = boundary faces on the surface).
-        ValidateOptions<3> vo;
-        if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
-        vo.boundary_distance = [&](const Point<3>& p) { return s.closest_point(p).distance; };
-        vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
-        const ValidationReport v = validate(fe.mesh, vo);
+        const ValidationReport v = validate(fe.mesh, surface_validation(s));
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         if (!v.valid) problems = std::move(*folds_pending);

@@ -13,6 +13,7 @@
 
 #include "core/orthtree.hpp"
 #include "core/stage_timer.hpp"
+#include "core/validate.hpp"
 #include "dim3/boundary_octants.hpp"
 #include "dim3/hex_dominant.hpp"
 #include "dim3/surface_boundary.hpp"
@@ -107,5 +108,10 @@ using Progress3 = std::function<void(const std::string&)>;
 /// with the buffer rule, the two once more without it (Result3d::buffer_dropped); when all
 /// fail, those without the buffer once more with facing projections (Options3d::retry_facing).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
+
+/// What a mesh of `s` is validated against (DESIGN.md, "Validity"): the solid's Euler
+/// characteristic is half the surface's (when that is even), and interface nodes lie on the
+/// surface within 1e-10 of its diagonal. The options refer to `s`, which must outlive them.
+ValidateOptions<3> surface_validation(const SurfaceBoundary& s);
 
 }  // namespace febemesh::dim3

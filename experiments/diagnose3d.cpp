@@ -90,11 +90,7 @@ int main(int argc, char** argv) {
       int repairs = 0;
       try {
         const Result3d r = mesh3d(s, opt, [](const std::string& m) { std::fprintf(stderr, "  %s\n", m.c_str()); });
-        ValidateOptions<3> vo;
-        if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
-        vo.boundary_distance = [&](const Point<3>& p) { return s.closest_point(p).distance; };
-        vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
-        const ValidationReport v = validate(r.fe.mesh, vo);
+        const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
         if (!v.valid) verdict = "INVALID " + v.summary();
         n_tets = r.fe.mesh.solid.size();
         min_dihedral = summarize_quality(r.fe.mesh).min_angle_deg;

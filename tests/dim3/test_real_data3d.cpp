@@ -69,10 +69,7 @@ DataRun mesh_and_validate(const std::string& name, int level, int max_repairs = 
   const Result3d r = mesh3d(s, opt);
   const Mesh<3>& m = r.fe.mesh;
   REQUIRE(m.solid.size() > 0);
-  ValidateOptions<3> vo;
-  if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
-  vo.boundary_distance = [&](const Point<3>& p) { return s.closest_point(p).distance; };
-  vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
+  const ValidateOptions<3> vo = surface_validation(s);
   const ValidationReport v = validate(m, vo);
   INFO(name << " level " << level << ": " << v.summary());
   CHECK(v.valid);
