@@ -32,8 +32,15 @@ struct Point2 {
 void plot(const std::vector<Point2>& pts, bool memory, const std::string& title, const fs::path& file) {
   SvgCanvas c(640.0, 30.0);
   auto y_of = [&](const Point2& p) { return memory ? p.bytes_per_element : p.us_per_element; };
+  // Log axes: a point without a positive value (a failed memory measurement) cannot be drawn,
+  // and one would make the decade loops below start at -infinity (they never ended and took
+  // the whole memory of the machine).
+  std::vector<Point2> drawn;
+  for (const auto& p : pts)
+    if (p.elements > 0 && y_of(p) > 0 && std::isfinite(y_of(p))) drawn.push_back(p);
+  if (drawn.empty()) return;
   double x0 = 1e300, x1 = 0, y0 = 1e300, y1 = 0;
-  for (const auto& p : pts) {
+  for (const auto& p : drawn) {
     x0 = std::min(x0, p.elements), x1 = std::max(x1, p.elements);
     y0 = std::min(y0, y_of(p)), y1 = std::max(y1, y_of(p));
   }
@@ -53,11 +60,11 @@ void plot(const std::vector<Point2>& pts, bool memory, const std::string& title,
   }
   c.polygon({Point<2>(0, 0), Point<2>(10, 0), Point<2>(10, 6), Point<2>(0, 6)}, {"none", "#444444", 1.0, 1.0});
   std::vector<std::string> series;
-  for (const auto& p : pts)
+  for (const auto& p : drawn)
     if (std::find(series.begin(), series.end(), p.series) == series.end()) series.push_back(p.series);
   for (std::size_t s = 0; s < series.size(); ++s) {
     std::vector<Point<2>> line;
-    for (const auto& p : pts)
+    for (const auto& p : drawn)
       if (p.series == series[s]) line.emplace_back(X(p.elements), Y(y_of(p)));
     const std::string colour = svg_palette(int(s));
     c.polyline(line, {"none", colour, 2.0, 1.0});
