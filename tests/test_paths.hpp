@@ -11,6 +11,9 @@ namespace febemesh::test {
 const char* data_dir();    ///< the shared data (2d/*.svg, 3d/*.off)
 const char* source_dir();  ///< the repository
 const char* cli_path();    ///< the built `febemesh` executable
+/// True in the sanitizer build (FEBEMESH_SANITIZE), where the suite runs a smaller budget:
+/// one case per property unless more are asked for, fewer levels of the real data.
+bool sanitized();
 
 }  // namespace febemesh::test
 

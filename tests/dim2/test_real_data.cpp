@@ -111,14 +111,20 @@ void check_combo(const Combo& c) {
 TEST_CASE("every shared 2D file and example meshes validly at levels 4-8, tri/quad/mixed", "[data][pipeline2d]") {
   const std::vector<std::string> files = data_files();
   REQUIRE(files.size() >= 3);
-  int n = 0;
+  // The sanitizer build (test::sanitized()) runs levels 4-5 only: levels 6-8 hold 98% of the
+  // elements, and under ASan they would take most of CI's time.
+  const std::vector<int> levels = test::sanitized() ? std::vector<int>{4, 5} : std::vector<int>{4, 5, 6, 7, 8};
+  int n = 0, n_known = 0;
   for (const std::string& file : files)
-    for (int level : {4, 5, 6, 7, 8})
+    for (int level : levels)
       for (ElementKind kind : {ElementKind::Tri, ElementKind::Mixed, ElementKind::Quad}) {
         const Combo c{file, level, kind};
-        if (is_known_failure(c)) continue;
+        if (is_known_failure(c)) {
+          ++n_known;
+          continue;
+        }
         check_combo(c);
         ++n;
       }
-  CHECK(n + int(known_failures.size()) == int(files.size()) * 15);
+  CHECK(n + n_known == int(files.size() * levels.size()) * 3);
 }

@@ -158,24 +158,7 @@ void check_valid(const Outcome3& out) {
 /// dozens of pipeline runs (measured: 87 runs, up to 19 s each, for one voxel case).
 template <typename Testable>
 void prop_mayfail(const std::string& description, int ci_cases, Testable&& testable) {
-  SECTION(description) {
-    rc::detail::TestParams params = rc::detail::configuration().testParams;
-    const bool overridden = std::getenv("FEBEMESH_PROPERTY_CASES") != nullptr ||
-                            (std::getenv("RC_PARAMS") != nullptr &&
-                             std::string(std::getenv("RC_PARAMS")).find("max_success") != std::string::npos);
-    if (!overridden) {
-      params.maxSuccess = ci_cases;
-      params.disableShrinking = true;
-    }
-    rc::detail::TestMetadata metadata;
-    metadata.id = description;
-    metadata.description = description;
-    const auto result = rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params);
-    std::ostringstream ss;
-    rc::detail::printResultMessage(result, ss);
-    INFO(description << "\n" << ss.str());
-    CHECK(result.template is<rc::detail::SuccessResult>());
-  }
+  test::prop(description, ci_cases, std::forward<Testable>(testable), false);
 }
 
 void validity_property(const char* what, int ci_cases, const rc::Gen<SurfaceSpec>& gen, int level, bool mayfail) {
