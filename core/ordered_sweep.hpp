@@ -75,17 +75,25 @@ SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbo
 }
 
 /// Runs visit(v, t) for every node of `dag` on n_threads threads (t in [0, n_threads), 0 = the
-/// caller), each node once its earlier neighbours are done, the lowest ready position first.
+/// caller), each node once its earlier neighbours are done, the lowest ready position of the
+/// thread's share of the positions first.
 /// Waiting threads sleep. The first exception (of the lowest thread) is rethrown once all
 /// threads have stopped; nodes not yet started are then not visited.
 template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit) {
   n_threads = std::max(1, n_threads);
   const std::size_t total = dag.size();
   std::unique_ptr<std::atomic<std::int32_t>[]> waiting(new std::atomic<std::int32_t>[total]);
-  std::priority_queue<std::int32_t, std::vector<std::int32_t>, std::greater<>> ready;
+  // One heap per thread's share of the positions: a thread takes from its own first, so the
+  // threads work apart in the mesh (fewer cache lines bounce) until one runs dry and helps.
+  using Heap = std::priority_queue<std::int32_t, std::vector<std::int32_t>, std::greater<>>;
+  std::vector<Heap> ready(static_cast<std::size_t>(n_threads));
+  std::size_t n_ready = 0;
+  const auto share = [&](std::int32_t i) {
+    return static_cast<std::size_t>(static_cast<std::uint64_t>(i) * static_cast<std::uint64_t>(n_threads) / total);
+  };
   for (std::size_t i = 0; i < total; ++i) {
     waiting[i].store(dag.n_earlier[i], std::memory_order_relaxed);
-    if (dag.n_earlier[i] == 0) ready.push(static_cast<std::int32_t>(i));
+    if (dag.n_earlier[i] == 0) ready[share(static_cast<std::int32_t>(i))].push(static_cast<std::int32_t>(i)), ++n_ready;
   }
   std::mutex m;
   std::condition_variable cv;
@@ -96,12 +104,19 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
     std::vector<std::int32_t> mine, freed;
     std::unique_lock lock(m);
     for (;;) {
-      cv.wait(lock, [&] { return failed || done == total || !ready.empty(); });
+      cv.wait(lock, [&] { return failed || done == total || n_ready > 0; });
       if (failed || done == total) return;
-      // A few of the lowest ready positions, leaving the others their share.
-      const std::size_t take = std::clamp<std::size_t>(ready.size() / static_cast<std::size_t>(2 * n_threads), 1, 8);
+      // A few of the lowest ready positions of this thread's share, else of the first share
+      // that has any.
+      std::size_t h = static_cast<std::size_t>(t);
+      if (ready[h].empty())
+        for (h = 0; ready[h].empty(); ++h) {
+        }
+      Heap& heap = ready[h];
+      const std::size_t take = std::clamp<std::size_t>(heap.size() / 2, 1, 8);
       mine.clear();
-      while (mine.size() < take && !ready.empty()) mine.push_back(ready.top()), ready.pop();
+      while (mine.size() < take && !heap.empty()) mine.push_back(heap.top()), heap.pop();
+      n_ready -= mine.size();
       lock.unlock();
       freed.clear();
       try {
@@ -120,11 +135,12 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
         return;
       }
       lock.lock();
-      for (const std::int32_t j : freed) ready.push(j);
+      for (const std::int32_t j : freed) ready[share(j)].push(j);
+      n_ready += freed.size();
       done += mine.size();
       if (done == total) {
         cv.notify_all();
-      } else if (freed.size() > 1 || (freed.size() == 1 && ready.size() > 1)) {
+      } else if (freed.size() > 1 || (freed.size() == 1 && n_ready > 1)) {
         cv.notify_one();
       }
     }
