@@ -47,8 +47,8 @@ options:
   --buffer F            drop interior quadrants nearer the curve than F x their size (default 0.35)
   --max-level N         finest level allowed, repairs included (default 16)
   --max-cells N         refuse trees larger than N quadrants (default 20000000)
-  --threads N           threads for refinement, classification and output (default: all cores);
-                        the mesh is the same byte for byte whatever N
+  --threads N           threads for refinement, classification, smoothing and output
+                        (default: all cores); the mesh is the same byte for byte whatever N
   --figures MODE        all | none | auto (default): auto draws the stage figures when the mesh
                         has at most 20000 elements; above, only figures/00-geometry.svg and a
                         figures/README.txt saying why (SVGs of 10^5 quadrants are unreadable,

@@ -9,6 +9,7 @@
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
 #include "core/mesh_topology.hpp"
+#include "core/ordered_sweep.hpp"
 #include "core/quality.hpp"
 
 namespace febemesh {
@@ -133,66 +134,93 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
 
   // The state of every element, refreshed where a move is accepted: the guard compares against
   // it instead of re-evaluating the incident elements before each move (same values).
-  std::vector<std::pair<bool, double>> state(mesh.solid.size()), after;
+  std::vector<std::pair<bool, double>> state(mesh.solid.size());
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) state[e] = element_state(static_cast<std::int32_t>(e));
   stats.min_quality_before = min_quality(state);
   // settled[v]: 1 if v's target was where it stands, 2 if its move was rejected, and no node of
   // its elements has moved since; its target, its elements' states and the trial states would
   // be the same numbers, so the same outcome: it is skipped (and counted as before).
   std::vector<std::uint8_t> settled(n, 0);
+  // The nodes that may move, swept in order; the visit of v reads and writes only the nodes and
+  // states of v's elements, so on several threads v goes as soon as its lower neighbours are
+  // done (core/ordered_sweep.hpp).
+  std::vector<std::int32_t> movable;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!options.fixed.empty() && options.fixed[v]) continue;
+    const bool slides = on_boundary[v] != 0;
+    if (slides && !options.project) continue;
+    const auto id = static_cast<std::int32_t>(v);
+    if ((slides ? boundary_neighbours.of(id) : neighbours.of(id)).empty() || incident.of(id).empty()) continue;
+    movable.push_back(id);
+  }
+  const OrderedSweep sweep(std::move(movable), n, options.n_threads, [&](std::int32_t v, auto&& visit) {
+    for (const std::int32_t e : incident.of(v)) {
+      const VertexId* ev = mesh.solid.nodes(ElemId{e});
+      for (int j = 0; j < mesh.solid.n_nodes_of(ElemId{e}); ++j) visit(ev[j].v);
+    }
+  });
+  struct alignas(64) PerThread {
+    std::vector<std::pair<bool, double>> after;
+    std::size_t accepted = 0, rejected = 0;
+  };
+  std::vector<PerThread> per_thread(static_cast<std::size_t>(sweep.n_threads()));
+  const auto visit = [&](std::int32_t v, int t) {
+    PerThread& my = per_thread[static_cast<std::size_t>(t)];
+    if (settled[v]) {
+      my.rejected += settled[v] == 2;
+      return;
+    }
+    const bool slides = on_boundary[v] != 0;
+    const auto nbrs = slides ? boundary_neighbours.of(v) : neighbours.of(v);
+    const auto elems = incident.of(v);
+    Point<Dim> target = Point<Dim>::Zero();
+    for (const auto w : nbrs) target += mesh.points[w];
+    target /= static_cast<double>(nbrs.size());
+    if (slides) target = options.project(target);
+    if (target == mesh.points[v]) {
+      settled[v] = 1;
+      return;
+    }
+
+    double old_min = std::numeric_limits<double>::infinity();
+    std::size_t worst = 0;
+    for (std::size_t k = 0; k < elems.size(); ++k) {
+      if (state[elems[k]].second < old_min) worst = k;
+      old_min = std::min(old_min, state[elems[k]].second);
+    }
+    const Point<Dim> saved = mesh.points[v];
+    mesh.points[v] = target;
+    // Accepted iff no valid element inverts and every element stays >= old_min: the first
+    // element that fails decides, the element that held old_min (likeliest to drop) first.
+    bool accept = true;
+    std::vector<std::pair<bool, double>>& after = my.after;
+    after.resize(elems.size());
+    for (std::size_t j = 0; j < elems.size() && accept; ++j) {
+      const std::size_t k = worst_first(j, worst);
+      after[k] = element_state(elems[k]);
+      accept = (after[k].first || !state[elems[k]].first) && after[k].second >= old_min;
+    }
+    if (accept) {
+      ++my.accepted;
+      for (std::size_t k = 0; k < elems.size(); ++k) {
+        state[elems[k]] = after[k];
+        const ElemId id{elems[k]};
+        const VertexId* ev = mesh.solid.nodes(id);
+        for (int j = 0; j < mesh.solid.n_nodes_of(id); ++j) mark(settled[ev[j].v], 0);
+      }
+    } else {
+      mesh.points[v] = saved;
+      ++my.rejected;
+      settled[v] = 2;
+    }
+  };
   for (int it = 0; it < options.n_iterations; ++it) {
     ++stats.iterations;
-    for (std::size_t v = 0; v < n; ++v) {
-      if (!options.fixed.empty() && options.fixed[v]) continue;
-      const bool slides = on_boundary[v] != 0;
-      if (slides && !options.project) continue;
-      if (settled[v]) {
-        stats.moves_rejected += settled[v] == 2;
-        continue;
-      }
-      const auto nbrs = slides ? boundary_neighbours.of(static_cast<std::int32_t>(v)) : neighbours.of(static_cast<std::int32_t>(v));
-      const auto elems = incident.of(static_cast<std::int32_t>(v));
-      if (nbrs.empty() || elems.empty()) continue;
-      Point<Dim> target = Point<Dim>::Zero();
-      for (const auto w : nbrs) target += mesh.points[w];
-      target /= static_cast<double>(nbrs.size());
-      if (slides) target = options.project(target);
-      if (target == mesh.points[v]) {
-        settled[v] = 1;
-        continue;
-      }
-
-      double old_min = std::numeric_limits<double>::infinity();
-      std::size_t worst = 0;
-      for (std::size_t k = 0; k < elems.size(); ++k) {
-        if (state[elems[k]].second < old_min) worst = k;
-        old_min = std::min(old_min, state[elems[k]].second);
-      }
-      const Point<Dim> saved = mesh.points[v];
-      mesh.points[v] = target;
-      // Accepted iff no valid element inverts and every element stays >= old_min: the first
-      // element that fails decides, the element that held old_min (likeliest to drop) first.
-      bool accept = true;
-      after.resize(elems.size());
-      for (std::size_t j = 0; j < elems.size() && accept; ++j) {
-        const std::size_t k = worst_first(j, worst);
-        after[k] = element_state(elems[k]);
-        accept = (after[k].first || !state[elems[k]].first) && after[k].second >= old_min;
-      }
-      if (accept) {
-        ++stats.moves_accepted;
-        for (std::size_t k = 0; k < elems.size(); ++k) {
-          state[elems[k]] = after[k];
-          const ElemId id{elems[k]};
-          const VertexId* ev = mesh.solid.nodes(id);
-          for (int j = 0; j < mesh.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
-        }
-      } else {
-        mesh.points[v] = saved;
-        ++stats.moves_rejected;
-        settled[v] = 2;
-      }
-    }
+    sweep.run(visit);
+  }
+  for (const PerThread& my : per_thread) {
+    stats.moves_accepted += my.accepted;
+    stats.moves_rejected += my.rejected;
   }
   stats.min_quality_after = min_quality(state);
   return stats;

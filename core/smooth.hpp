@@ -21,6 +21,9 @@ template <int Dim> struct SmoothOptions {
   std::vector<std::uint8_t> fixed;
   /// Maps a point near the boundary onto it; when set, boundary nodes may slide.
   std::function<Point<Dim>(const Point<Dim>&)> project;
+  /// Threads for the sweeps (project must then be safe to call concurrently); the result is the
+  /// same, bit for bit, for every count.
+  int n_threads = 1;
 };
 
 struct SmoothStats {

@@ -103,6 +103,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       say("smoothing: " + std::to_string(opt.smoothing_iterations) + " Laplacian iterations");
       SmoothOptions<2> so;
       so.n_iterations = opt.smoothing_iterations;
+      so.n_threads = opt.n_threads;
       if (opt.slide_boundary) {
         so.fixed.assign(fe.mesh.points.size(), 0);
         for (std::size_t v = 0; v < fe.where.size(); ++v)

@@ -29,7 +29,7 @@ struct Options2d {
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
-  int n_threads = 1;                 ///< threads for refinement and classification; results do not depend on it
+  int n_threads = 1;                 ///< threads for refinement, classification and smoothing; results do not depend on it
   bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures
   /// Stages are dropped (and the unpulled complex is not rebuilt) when the mesh has more FE
   /// elements than this: figures of 10^5 quadrants are unreadable and cost more than meshing.

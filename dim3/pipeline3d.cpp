@@ -200,7 +200,7 @@ std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe
 /// `escobar` the smooth last resort. Surface nodes stay on the surface, corners stay put.
 TetOptimizeStats untangle_pass(TetMesh& fe, const OctantComplex& oc, int sweeps, bool escobar,
                                const SurfaceProjection& project,
-                               const std::function<P3(const BoundaryLocation&)>& normal) {
+                               const std::function<P3(const BoundaryLocation&)>& normal, int n_threads) {
   TetOptimizeOptions to;
   to.untangle_only = true;
   to.escobar = escobar;
@@ -208,6 +208,7 @@ TetOptimizeStats untangle_pass(TetMesh& fe, const OctantComplex& oc, int sweeps,
   to.fixed = fixed_nodes(oc, fe, false);
   to.project = project;
   to.surface_normal = normal;
+  to.n_threads = n_threads;
   return optimize_tets(fe.mesh, fe.where, to);
 }
 
@@ -452,7 +453,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
           // Untangle by moving nodes (interior ones freely, surface ones on the surface,
           // corners not at all) before giving up snaps or refining.
           const TetOptimizeStats ts =
-              untangle_pass(fe, oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal);
+              untangle_pass(fe, oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads);
           r.n_untangle_moves += ts.moves;
           say(untangle_summary("untangling", ts));
         }
@@ -481,7 +482,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
               std::vector<Problem3> old_problems;
               add_problems(fe.mesh, bad, folded, "", old_problems);
               const TetOptimizeStats ts =
-                  untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal);
+                  untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal, opt.n_threads);
               r.n_untangle_moves += ts.moves;
               say(untangle_summary("untangling (Escobar objective)", ts));
               bad2 = inverted_elements(fe.mesh);
@@ -515,6 +516,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
       say("smoothing: " + std::to_string(opt.smoothing_iterations) + " guarded Laplacian iterations");
       SmoothOptions<3> so;
       so.n_iterations = opt.smoothing_iterations;
+      so.n_threads = opt.n_threads;
       so.fixed.assign(fe.mesh.points.size(), 0);
       for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
       const SmoothStats ss = smooth(fe.mesh, so);
@@ -529,6 +531,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         to.fixed = fixed_nodes(oc.complex, fe, true);
         to.project = surface_point;
         to.surface_normal = surface_normal;
+        to.n_threads = opt.n_threads;
         const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
         r.n_optimize_moves = ts.moves;
       }

@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include "core/error.hpp"
+#include "core/ordered_sweep.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -109,8 +110,12 @@ struct Optimizer {
   /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
   std::vector<double> tet_q;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
-  std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
-  std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
+  /// One thread's working space for relax.
+  struct alignas(64) Scratch {
+    std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
+    std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
+    std::size_t moves = 0;
+  };
 
   /// Search quality of interface triangle f with node v at x (normal nx there): +inf when it
   /// is aligned with the surface, else like an inverted tetrahedron (-1 + cosine, in [-2, -1]).
@@ -175,9 +180,11 @@ struct Optimizer {
     }
     return g;
   }
-  /// worst_above over `local` (relax's incident tetrahedra).
-  /// Without an early stop, trial[i] holds every incident tetrahedron's rank at x.
-  double local_worst_above(const P3& x, double bound, std::int32_t& first) {
+  /// worst_above over sc.local (relax's incident tetrahedra).
+  /// Without an early stop, sc.trial[i] holds every incident tetrahedron's rank at x.
+  static double local_worst_above(Scratch& sc, const P3& x, double bound, std::int32_t& first) {
+    const std::vector<MovingTet>& local = sc.local;
+    std::vector<double>& trial = sc.trial;
     const std::int32_t n = static_cast<std::int32_t>(local.size());
     double w = std::numeric_limits<double>::infinity();
     for (std::int32_t j = 0; j < n; ++j) {
@@ -314,8 +321,12 @@ struct Optimizer {
     return start[v + 1] > start[v];
   }
 
-  /// One local search at node v; returns true if it moved.
-  bool relax(std::int32_t v) {
+  /// One local search at node v; returns true if it moved. Reads v's neighbours and the
+  /// ranks of v's tetrahedra, writes v (point, location, normal) and those ranks.
+  bool relax(std::int32_t v, Scratch& sc) {
+    std::vector<MovingTet>& local = sc.local;
+    std::vector<double>& trial = sc.trial;
+    std::vector<double>& best_ranks = sc.best_ranks;
     const P3 x0 = mesh.points[v];
     std::int32_t worst_local = 0;
     const bool surf = is_surface(v);
@@ -370,7 +381,7 @@ struct Optimizer {
       P3 x = c;
       BoundaryLocation w;
       if (surf) std::tie(x, w) = opt.project(c);
-      double f = local_worst_above(x, best + 1e-12, worst_local);
+      double f = local_worst_above(sc, x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }
@@ -444,7 +455,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}, {}, {}};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -530,17 +541,36 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   // v, repeated with the same numbers, does not move it either: such nodes are skipped (the
   // moves, and so the mesh, are those of searching them again).
   std::vector<std::uint8_t> stale(n, 1), next(n, 0);
+  // Each sweep visits the active movable nodes in order; relax(v) reads and writes only v's
+  // neighbourhood (its tetrahedra and interface triangles), so on several threads the sweep
+  // visits v as soon as its lower neighbours are done (core/ordered_sweep.hpp) and moves the
+  // nodes the serial sweep moves.
+  const auto for_neighbours = [&](std::int32_t v, auto&& visit) {
+    for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) visit(o.nbs[k]);
+    if (o.f_start.empty()) return;
+    for (std::int32_t k = o.f_start[v]; k < o.f_start[v + 1]; ++k)
+      for (const std::int32_t u : o.faces[o.f_incident[k]]) visit(u);
+  };
+  std::vector<Optimizer::Scratch> scratch(static_cast<std::size_t>(std::max(1, opt.n_threads)));
+  std::vector<std::int32_t> nodes;
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
     std::fill(next.begin(), next.end(), 0);
-    std::size_t moved = 0;
-    for (std::size_t v = 0; v < n; ++v) {
-      if (!active[v] || !stale[v] || !o.movable(static_cast<std::int32_t>(v))) continue;
+    nodes.clear();
+    for (std::size_t v = 0; v < n; ++v)
+      if (active[v] && o.movable(static_cast<std::int32_t>(v))) nodes.push_back(static_cast<std::int32_t>(v));
+    for (Optimizer::Scratch& sc : scratch) sc.moves = 0;
+    const OrderedSweep order(nodes, n, opt.n_threads, for_neighbours);
+    order.run([&](std::int32_t v, int t) {
+      if (!stale[v]) return;
       stale[v] = 0;
-      if (!o.relax(static_cast<std::int32_t>(v))) continue;
-      ++moved;
-      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) next[o.nbs[k]] = 1, stale[o.nbs[k]] = 1;
+      Optimizer::Scratch& sc = scratch[static_cast<std::size_t>(t)];
+      if (!o.relax(v, sc)) return;
+      ++sc.moves;
+      for (std::int32_t k = o.nb_start[v]; k < o.nb_start[v + 1]; ++k) mark(next[o.nbs[k]], 1), mark(stale[o.nbs[k]], 1);
       next[v] = 1, stale[v] = 1;
-    }
+    });
+    std::size_t moved = 0;
+    for (const Optimizer::Scratch& sc : scratch) moved += sc.moves;
     st.sweeps = sweep + 1;
     st.moves += moved;
     if (moved == 0) break;

@@ -47,6 +47,9 @@ struct TetOptimizeOptions {
   /// tetrahedra alone let a surface node slide over its neighbours, and the mesh then covers
   /// a strip twice.
   std::function<Point<3>(const BoundaryLocation&)> surface_normal;
+  /// Threads for the sweeps (project and surface_normal must then be safe to call
+  /// concurrently); the result is the same, bit for bit, for every count.
+  int n_threads = 1;
 };
 
 struct TetOptimizeStats {

@@ -40,3 +40,16 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
   CHECK(!std::filesystem::exists(dir / "0"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads with features and sliding surface nodes", "[cli][mesh3d]") {
+  // Spool: feature snapping, surface nodes that slide in the tet optimiser (projected onto the
+  // surface on both threads), 53k tets; the smoothing and the optimiser run on 2 threads.
+  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_spool_" + std::to_string(::getpid()));
+  const std::string spool = std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off";
+  for (const char* n : {"1", "2"})
+    REQUIRE(run_status("mesh3d '" + spool + "' -o '" + (dir / n).string() + "' --level 4 --quiet --threads " + n) == 0);
+  const std::string one = read_text(dir / "1" / "mesh.msh"), two = read_text(dir / "2" / "mesh.msh");
+  CHECK(one.size() > 1000);
+  CHECK(one == two);
+  std::filesystem::remove_all(dir);
+}

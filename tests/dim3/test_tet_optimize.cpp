@@ -1,11 +1,12 @@
 // tet_optimize: the search rank (no acos) orders tetrahedra like the angle-based search quality
 // (its slow twin) and has its sign; the optimiser never lowers the worst dihedral angle or
-// inverts a tetrahedron, and gives the same mesh when run twice.
+// inverts a tetrahedron, and gives the same mesh when run twice and on any number of threads.
 
 #include <catch2/catch.hpp>
 #include <rapidcheck.h>
 
 #include <cmath>
+#include <utility>
 
 #include "core/mesh.hpp"
 #include "dim3/tet_optimize.hpp"
@@ -26,10 +27,9 @@ rc::Gen<P3> gen_point() {
                       });
 }
 
-/// A jittered cube of 5^3 nodes cut into six tetrahedra per cell (Kuhn), all positive.
-Mesh<3> jittered_cube(double jitter, unsigned seed) {
+/// A jittered cube of n^3 nodes cut into six tetrahedra per cell (Kuhn), all positive.
+Mesh<3> jittered_cube(double jitter, unsigned seed, int n = 5) {
   Mesh<3> m;
-  const int n = 5;
   auto id = [&](int i, int j, int k) { return (k * n + j) * n + i; };
   std::uint64_t s = seed;
   auto rnd = [&] {
@@ -123,5 +123,59 @@ TEST_CASE("optimize_tets raises the worst dihedral angle, inverts nothing, is re
     CHECK(min_dihedral(m) > before);
     CHECK(st.min_dihedral_after_deg == Approx(min_dihedral(m)).margin(1e-6));
     CHECK(m.points == again.points);
+  }
+}
+
+TEST_CASE("optimize_tets gives the same mesh on 1, 2 and 3 threads", "[tet_optimize][threads]") {
+  // 13^3 nodes: more than a thousand active ones, so that the sweeps run on several threads.
+  // The cube's edges and corners stay; with a projection, the nodes of its faces slide on them.
+  const int n = 13;
+  const double hi = n - 1;
+  for (const bool slide : {false, true}) {
+    const Mesh<3> start = jittered_cube(0.6, 4, n);
+    std::vector<BoundaryLocation> where(start.points.size());
+    TetOptimizeOptions opt;
+    opt.max_sweeps = 8;
+    opt.fixed.assign(start.points.size(), 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v) {
+      int on = 0;
+      for (int d = 0; d < 3; ++d) on += start.points[v][d] == 0.0 || start.points[v][d] == hi;
+      opt.fixed[v] = on >= (slide ? 2 : 1) ? 1 : 0;
+      if (on == 1) where[v].patch = 0;
+    }
+    if (slide) {
+      opt.project = [hi](const P3& p) {
+        P3 q = p.cwiseMax(0.0).cwiseMin(hi);
+        int best = 0;
+        double dist = 1e300;
+        for (int d = 0; d < 3; ++d)
+          for (const double side : {0.0, hi})
+            if (std::abs(q[d] - side) < dist) dist = std::abs(q[d] - side), best = 2 * d + (side > 0);
+        q[best / 2] = best % 2 ? hi : 0.0;
+        BoundaryLocation w;
+        w.patch = best;
+        return std::make_pair(q, w);
+      };
+    }
+    Mesh<3> one = start;
+    std::vector<BoundaryLocation> where1 = where;
+    const TetOptimizeStats s1 = optimize_tets(one, where1, opt);
+    CAPTURE(slide);
+    REQUIRE(s1.moves > 1000);
+    for (const int threads : {2, 3}) {
+      Mesh<3> many = start;
+      std::vector<BoundaryLocation> wheren = where;
+      opt.n_threads = threads;
+      const TetOptimizeStats sn = optimize_tets(many, wheren, opt);
+      CAPTURE(threads);
+      CHECK(many.points == one.points);
+      CHECK(sn.moves == s1.moves);
+      CHECK(sn.sweeps == s1.sweeps);
+      CHECK(sn.min_dihedral_after_deg == s1.min_dihedral_after_deg);
+      bool same_where = true;
+      for (std::size_t v = 0; v < where.size(); ++v)
+        same_where = same_where && wheren[v].patch == where1[v].patch;
+      CHECK(same_where);
+    }
   }
 }

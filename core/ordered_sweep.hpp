@@ -1,0 +1,188 @@
+#pragma once
+// In-order node sweeps on several threads with the serial result, bit for bit (issue 8).
+//
+// A Gauss-Seidel sweep (the guarded smoothing, the tet optimiser) visits the nodes of a graph
+// in increasing order, and the visit of v reads v and its neighbours and writes v (and marks its
+// neighbours, below). Such a sweep computes the same numbers when v is visited as soon as its
+// neighbours u < v in the sweep are done, in whatever order and on whatever thread: every
+// neighbour u < v is still visited before v and every u > v after it. The sweep is a DAG
+// (edges from lower to higher neighbours) scheduled as it unfolds, as for sparse triangular
+// solves (Anderson & Saad 1989, there by levels). No barriers: on a loaded machine a thread the
+// kernel parks holds up only the nodes that wait for the one it holds, not a whole level.
+// The order of the mesh's nodes, which the serial sweep keeps, is unchanged, so any thread count
+// gives the serial mesh.
+//
+// A visit may write to a neighbour's flag only a value that every writer writes (a "moved" or
+// "stale" mark), through mark(): two nodes visited at once may mark the same neighbour.
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <queue>
+#include <span>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace febemesh {
+
+/// Sets flag = value where other threads may set the same flag to the same value meanwhile.
+inline void mark(std::uint8_t& flag, std::uint8_t value) {
+  std::atomic_ref<std::uint8_t>(flag).store(value, std::memory_order_relaxed);
+}
+
+/// The dependencies of an in-order sweep, by position in the sweep (see the file comment).
+struct SweepDag {
+  std::vector<std::int32_t> node;        ///< the sweep's nodes, ascending
+  std::vector<std::int32_t> next_start;  ///< position i's later neighbours: next[next_start[i] ..
+  std::vector<std::int32_t> next;        ///<   next_start[i+1]), positions, ascending, distinct
+  std::vector<std::int32_t> n_earlier;   ///< number of position i's earlier neighbours
+  std::size_t size() const { return node.size(); }
+  std::span<const std::int32_t> later(std::size_t i) const {
+    return {next.data() + next_start[i], static_cast<std::size_t>(next_start[i + 1] - next_start[i])};
+  }
+};
+
+/// The DAG of the in-order sweep over `nodes` (ascending, each < n) of a graph whose neighbours
+/// of v are listed by for_neighbours(v, f), calling f(u) for each (repeats and u = v allowed;
+/// neighbours outside the sweep are ignored). The relation must be symmetric.
+template <class Neighbours>
+SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbours& for_neighbours) {
+  SweepDag d;
+  d.node = std::move(nodes);
+  std::vector<std::int32_t> position(n, -1);
+  for (std::size_t i = 0; i < d.node.size(); ++i) position[static_cast<std::size_t>(d.node[i])] = static_cast<std::int32_t>(i);
+  d.next_start.assign(d.node.size() + 1, 0);
+  d.n_earlier.assign(d.node.size(), 0);
+  for (std::size_t i = 0; i < d.node.size(); ++i) {
+    const std::size_t first = d.next.size();
+    for_neighbours(d.node[i], [&](std::int32_t u) {
+      const std::int32_t j = position[static_cast<std::size_t>(u)];
+      if (j > static_cast<std::int32_t>(i)) d.next.push_back(j);
+    });
+    std::sort(d.next.begin() + static_cast<std::ptrdiff_t>(first), d.next.end());
+    d.next.erase(std::unique(d.next.begin() + static_cast<std::ptrdiff_t>(first), d.next.end()), d.next.end());
+    for (std::size_t k = first; k < d.next.size(); ++k) ++d.n_earlier[static_cast<std::size_t>(d.next[k])];
+    d.next_start[i + 1] = static_cast<std::int32_t>(d.next.size());
+  }
+  return d;
+}
+
+/// Runs visit(v, t) for every node of `dag` on n_threads threads (t in [0, n_threads), 0 = the
+/// caller), each node once its earlier neighbours are done, the lowest ready position of the
+/// thread's share of the positions first.
+/// Waiting threads sleep. The first exception (of the lowest thread) is rethrown once all
+/// threads have stopped; nodes not yet started are then not visited.
+template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit) {
+  n_threads = std::max(1, n_threads);
+  const std::size_t total = dag.size();
+  std::unique_ptr<std::atomic<std::int32_t>[]> waiting(new std::atomic<std::int32_t>[total]);
+  // One heap per thread's share of the positions: a thread takes from its own first, so the
+  // threads work apart in the mesh (fewer cache lines bounce) until one runs dry and helps.
+  using Heap = std::priority_queue<std::int32_t, std::vector<std::int32_t>, std::greater<>>;
+  std::vector<Heap> ready(static_cast<std::size_t>(n_threads));
+  std::size_t n_ready = 0;
+  const auto share = [&](std::int32_t i) {
+    return static_cast<std::size_t>(static_cast<std::uint64_t>(i) * static_cast<std::uint64_t>(n_threads) / total);
+  };
+  for (std::size_t i = 0; i < total; ++i) {
+    waiting[i].store(dag.n_earlier[i], std::memory_order_relaxed);
+    if (dag.n_earlier[i] == 0) ready[share(static_cast<std::int32_t>(i))].push(static_cast<std::int32_t>(i)), ++n_ready;
+  }
+  std::mutex m;
+  std::condition_variable cv;
+  std::size_t done = 0;
+  bool failed = false;
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_threads));
+  const auto run = [&](int t) {
+    std::vector<std::int32_t> mine, freed;
+    std::unique_lock lock(m);
+    for (;;) {
+      cv.wait(lock, [&] { return failed || done == total || n_ready > 0; });
+      if (failed || done == total) return;
+      // A few of the lowest ready positions of this thread's share, else of the first share
+      // that has any.
+      std::size_t h = static_cast<std::size_t>(t);
+      if (ready[h].empty())
+        for (h = 0; ready[h].empty(); ++h) {
+        }
+      Heap& heap = ready[h];
+      const std::size_t take = std::clamp<std::size_t>(heap.size() / 2, 1, 8);
+      mine.clear();
+      while (mine.size() < take && !heap.empty()) mine.push_back(heap.top()), heap.pop();
+      n_ready -= mine.size();
+      lock.unlock();
+      freed.clear();
+      try {
+        for (const std::int32_t i : mine) {
+          visit(dag.node[static_cast<std::size_t>(i)], t);
+          // acq_rel: the last earlier neighbour to finish sees the others' writes, and the
+          // thread that takes the node (under the mutex) sees them all.
+          for (const std::int32_t j : dag.later(static_cast<std::size_t>(i)))
+            if (waiting[static_cast<std::size_t>(j)].fetch_sub(1, std::memory_order_acq_rel) == 1) freed.push_back(j);
+        }
+      } catch (...) {
+        lock.lock();
+        errors[static_cast<std::size_t>(t)] = std::current_exception();
+        failed = true;
+        cv.notify_all();
+        return;
+      }
+      lock.lock();
+      for (const std::int32_t j : freed) ready[share(j)].push(j);
+      n_ready += freed.size();
+      done += mine.size();
+      if (done == total) {
+        cv.notify_all();
+      } else if (freed.size() > 1 || (freed.size() == 1 && n_ready > 1)) {
+        cv.notify_one();
+      }
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < n_threads; ++t) threads.emplace_back(run, t);
+  run(0);
+  for (auto& th : threads) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+/// An in-order sweep over `nodes` (ascending), to be run once or repeatedly: on one thread (or
+/// for fewer than `min_nodes` nodes) run() visits them in that order, on several as the DAG
+/// allows; the visits see the same numbers either way (see the file comment).
+class OrderedSweep {
+ public:
+  template <class Neighbours>
+  OrderedSweep(std::vector<std::int32_t> nodes, std::size_t n, int n_threads, const Neighbours& for_neighbours,
+               std::size_t min_nodes = 1024)
+      : n_threads_(std::max(1, n_threads)) {
+    if (n_threads_ > 1 && nodes.size() >= min_nodes) {
+      dag_ = sweep_dag(n, std::move(nodes), for_neighbours);
+    } else {
+      n_threads_ = 1;
+      dag_.node = std::move(nodes);
+    }
+  }
+  std::size_t size() const { return dag_.size(); }
+  int n_threads() const { return n_threads_; }
+  /// visit(v, t) for every node, t the thread (0 = the caller).
+  template <class Visit> void run(const Visit& visit) const {
+    if (n_threads_ == 1) {
+      for (const std::int32_t v : dag_.node) visit(v, 0);
+    } else {
+      visit_dag(dag_, n_threads_, visit);
+    }
+  }
+
+ private:
+  SweepDag dag_;
+  int n_threads_ = 1;
+};
+
+}  // namespace febemesh
