@@ -248,6 +248,14 @@ std::vector<P3> nodes_behind(const Orthtree<3>& t, const OctantComplex& oc, cons
 
 Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
 
+/// Volume of the leaves kept `before` keep_largest_components and dropped by it (`after`).
+double island_volume(const Orthtree<3>& t, const Flags& before, const Flags& after) {
+  double v = 0.0;
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    if (before[i] && !after[i]) v += geometry(t, t.leaf(i)).extent().prod();
+  return v;
+}
+
 /// run(opt), and when that throws GeometryError, once more with `fallback` (the same input and
 /// the same fallback, so still deterministic), reporting why and setting `dropped`.
 template <typename Run>
@@ -367,8 +375,19 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
   std::optional<Saved> saved;  // the last valid mesh whose topology a refinement tries to fix
   int island_refinements = 0;
   std::vector<double> thickness;  // of each surface triangle, when an island refinement needs it
+  // An island refinement above island_max_fraction is tried once: kept when the volume of the
+  // octants dropped as islands shrinks (the thin part is resolved: tori at level 3, whose whole
+  // tube is two octants thick), else the tree before it comes back (rotor's blades multiply
+  // their islands). Its tries count as island refinements for the repair budget.
+  struct IslandTrial {
+    Orthtree<3> tree;  ///< before the refinement
+    double island_volume = 0.0;
+  };
+  std::optional<IslandTrial> island_trial;
+  bool island_trial_done = false;
+  int trial_attempts = 0;  // attempts spent on a reverted trial
   for (int attempt = 0;; ++attempt) {
-    const bool last = attempt - island_refinements >= opt.max_repairs;
+    const bool last = attempt - island_refinements - trial_attempts >= opt.max_repairs;
     say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
     const std::vector<Side> sides = classify(tree, s, opt.n_threads);
     Flags in = interior_flags(sides);
@@ -377,6 +396,19 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
     r.n_pinches_dropped = remove_pinches(tree, in);
     const Flags before_islands = in;
     r.n_islands_dropped = keep_largest_components(tree, in, s.n_components());
+    if (island_trial) {
+      const bool kept = island_volume(tree, before_islands, in) < island_trial->island_volume;
+      say("interior octants: " + std::to_string(r.n_islands_dropped) + " in islands after the refinement above " +
+          "the share limit; " + (kept ? "keeping it" : "going back to the tree before it"));
+      if (!kept) {
+        tree = std::move(island_trial->tree);
+        island_trial.reset();
+        --island_refinements;  // the trial and this attempt count as trial_attempts instead
+        trial_attempts += 2;
+        continue;
+      }
+      island_trial.reset();
+    }
     if (r.n_islands_dropped > 0 && island_refinements < opt.island_refinements) {
       // A part thinner than the octants falls apart: refine around the pieces it left before
       // building anything on this tree (refining every octant on the surface instead folds).
@@ -409,7 +441,12 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
       // Where most of the surface is thin (rotor's blades at level 4) the level is too coarse
       // for the shape, not for a few handles: refining all of it multiplies the islands and the
       // octants (measured: rotor 12608 -> 324647 octants, islands 82 -> 1164).
-      if (marked && n_marked <= opt.island_max_fraction * tree.n_leaves()) {
+      const bool over_share = n_marked > opt.island_max_fraction * tree.n_leaves();
+      if (marked && over_share && !island_trial_done) {
+        island_trial_done = true;
+        island_trial = IslandTrial{tree, island_volume(tree, before_islands, in)};
+      }
+      if (marked && (!over_share || island_trial)) {
         ++island_refinements;
         say("interior octants: " + std::to_string(r.n_islands_dropped) + " in islands; refining " +
             std::to_string(n_marked) + " octants around them and on thin surface");
@@ -620,7 +657,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
     }
     // Refining around inverted elements can add more than it removes (measured on fandisk,
     // rotor, spool, anchor, elephant): stop as soon as a repair makes things worse.
-    const bool worse = attempt > island_refinements && problems.size() > n_prev_problems;
+    const bool worse = attempt > island_refinements + trial_attempts && problems.size() > n_prev_problems;
     n_prev_problems = problems.size();
     Flags flags;
     std::vector<P3> places;

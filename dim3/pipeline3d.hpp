@@ -65,7 +65,9 @@ struct Options3d {
   /// With an island refinement, also split the octants on the surface whose triangles are
   /// thinner (SurfaceBoundary::thickness) than this x their size; 0 = off.
   double thin_cells = 1.5;
-  /// No island refinement when it would split more than this share of the leaves.
+  /// An island refinement that would split more than this share of the leaves is tried once
+  /// per run and kept only if the volume of the octants dropped as islands shrinks (a tube two
+  /// octants thick: resolved; rotor's blades at level 4: more islands, the tree before it stays).
   double island_max_fraction = 0.12;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)

@@ -80,6 +80,8 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--island-refinements") opt.island_refinements = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--island-cells") opt.island_cells = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--thin-cells") opt.thin_cells = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--island-max-fraction") opt.island_max_fraction = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--topology-refinements") opt.topology_refinements = std::atoi(argv[i + 1]);
   }
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--pipeline") {

@@ -4,10 +4,11 @@
 // A failure prints the seed (replay with RC_PARAMS="seed=S") and the shrunk case as an OFF file,
 // which goes to tests/dim3/regressions/ (replayed at the end of this file, not as [property]).
 //
-// What the pipeline does not handle yet is split from what it does: perturbed 320-triangle
-// icospheres are asserted hard (300 local cases, all valid); coarse 80-triangle spheres, tori and
-// voxel unions run in [!mayfail] cases that keep reporting (see the comments there for the
-// failures they found). Without FEBEMESH_PROPERTY_CASES the [!mayfail] ones do not shrink.
+// What the pipeline does not handle yet is split from what it does: perturbed icospheres of 320
+// triangles (300 local cases) and of 80 or 320 (800 local cases, session 8) are asserted hard;
+// tori and voxel unions run in [!mayfail] cases that keep reporting (see the comments there for
+// the failures they found). Without FEBEMESH_PROPERTY_CASES the [!mayfail] ones do not shrink.
+// The hidden "[.survey]" case counts a family's failures over many cases without stopping.
 
 #include <catch2/catch.hpp>
 
@@ -180,25 +181,41 @@ TEST_CASE("3D pipeline output is valid on perturbed spheres", "[property][pipeli
 }
 
 // Coarse icospheres (80 triangles, so dihedral angles up to ~40 degrees at the perturbed bumps):
-// the session 2 shrunk case (regressions/sphere-coarse-inverted-element.off) is fixed; at the CI
-// seed 2 of 5 runs are still refused (GeometryError: inverted elements after the repairs).
-TEST_CASE("3D pipeline output is valid on coarse perturbed spheres", "[property][pipeline3d][!mayfail]") {
-  validity_property("perturbed spheres (80 or 320 triangles)", 4, test::gen_sphere_spec(1), 3, true);
+// the session 2 shrunk case (regressions/sphere-coarse-inverted-element.off) is fixed. Session 8
+// survey (FEBEMESH_SURVEY=sphere1): 100 cases at seed 1 and 400 at seed 2 all valid before the
+// island trial, 300 at seed 5 all valid after it; asserted hard since.
+TEST_CASE("3D pipeline output is valid on coarse perturbed spheres", "[property][pipeline3d]") {
+  validity_property("perturbed spheres (80 or 320 triangles)", 4, test::gen_sphere_spec(1), 3, false);
 }
 
 // Tori: session 2 failed at case 49 (inverted elements, shrunk to regressions/torus-inverted-
 // element.off, now fixed by the fold guard). Session 3 fixed two more shrunk cases (a thin ring
 // losing its handle: torus-thin-ring-euler.off; feature snapping on a 12x8 torus:
-// torus-12x8-feature-snap-inverted.off). Passes at the CI seed; locally 100 requested cases
-// first failed at case 79 (GeometryError, 2 refused of 80 runs, 0 invalid), so still [!mayfail].
+// torus-12x8-feature-snap-inverted.off). Session 8 (survey below, seed 3, 400 requested): 8 of
+// the first 286 were invalid, all Euler 1 instead of 0 (the handle lost). 7 had islands at
+// level 3 (the whole tube two octants thick) whose refinement the share limit skipped, and the
+// fallback (refine every surface octant) folds; the island refinement is now tried above the
+// limit (regressions/torus-28x16-islands-over-share-limit.off); the same 400 cases then fail
+// once: the 8th, a 12x8 torus with no islands but Euler 1 on its first tree, still goes through
+// the surface refinement that folds and keeps the coarse mesh with the wrong topology
+// (regressions/mayfail-torus-12x8-topology-refinement-folds.off), so still [!mayfail].
 TEST_CASE("3D pipeline output is valid on tori", "[property][pipeline3d][!mayfail]") {
   validity_property("tori", 4, test::gen_torus_spec(), 3, true);
 }
 
 // Voxel unions: the rotated cube's 2 hanging nodes were a fold of the surface mesh (fixed in
 // session 3: folded interface triangles count as bad elements; regressions/voxel-cube-rotated-
-// hanging-nodes.off). Passes at the CI seed; locally 100 requested cases first failed at case 34
-// (GeometryError: inverted elements the untangling cannot fix, 0 invalid meshes), so [!mayfail].
+// hanging-nodes.off). Session 8 (survey below): seed 1, 100 cases all valid; seed 4, 3 of the
+// first 182 fail: two refused (inverted tetrahedra the untangling cannot fix, and refining makes
+// more: regressions/mayfail-voxel-notched-cube-inverted.off, 7 of 8 cells of a 2x2x2 grid) and
+// one invalid (2 hanging nodes on a 4x4x4 union), so [!mayfail]. After the island trial the same
+// three fail, one of them (case 99) now invalid instead of refused: in the last try the trial
+// removed its islands, then Euler 0 (expected 1) sent it to the surface refinement that folds,
+// which keeps the coarse mesh with the wrong topology (as the 12x8 torus above). Cases 182-199
+// fail 4 times after it; rerun with the code before it, 182, 190 and 199 fail the same way, but
+// 185 was valid (54154 tets, 11.4 deg, 1 repair) and is refused after it (16 inverted elements
+// after 2 repairs): a regression of the island trial, kept as regressions/mayfail-voxel-island-
+// trial-refused.off.
 TEST_CASE("3D pipeline output is valid on voxel unions", "[property][pipeline3d][!mayfail]") {
   validity_property("voxel unions", 4, test::gen_voxel_spec(), 3, true);
 }
@@ -238,6 +255,60 @@ TEST_CASE("the 3D FE volume approaches the surface's volume as the level rises",
     RC_ASSERT(err[2] < err[0]);
   });
   tally.print("volume convergence");
+}
+
+// ---- survey: how many cases of a family fail, without stopping at the first (hidden) ----
+
+// FEBEMESH_SURVEY=sphere1|torus|voxel FEBEMESH_SURVEY_CASES=N [FEBEMESH_SURVEY_DIR=DIR]
+// [RC_PARAMS="seed=S"] test_dim3 "[.survey]": runs N generated cases of the family (the same
+// generators and sizes as the properties above), prints every refused or invalid one and, with
+// FEBEMESH_SURVEY_DIR, writes it there as an OFF file (unshrunk). Never fails: it measures.
+TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
+  const char* kind = std::getenv("FEBEMESH_SURVEY");
+  if (!kind) return;
+  const std::string k = kind;
+  const rc::Gen<SurfaceSpec> gen = k == "torus"   ? test::gen_torus_spec()
+                                  : k == "voxel"  ? test::gen_voxel_spec()
+                                  : k == "sphere2" ? test::gen_sphere_spec(2)
+                                                   : test::gen_sphere_spec(1);
+  const char* cases_env = std::getenv("FEBEMESH_SURVEY_CASES");
+  const char* dir = std::getenv("FEBEMESH_SURVEY_DIR");
+  rc::detail::TestParams params = rc::detail::configuration().testParams;
+  params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
+  params.disableShrinking = true;
+  Tally tally;
+  long n = 0, failed = 0;
+  rc::detail::TestMetadata metadata;
+  metadata.id = metadata.description = "survey " + k;
+  rc::detail::checkTestable(
+      [&] {
+        const SurfaceSpec spec = *gen;
+        const long index = n++;
+        std::string why;
+        const auto t0 = std::chrono::steady_clock::now();
+        try {
+          const Outcome3 out = run_surface(test::to_surface(spec), spec.level);
+          ++tally.cases;
+          if (!out.v.valid) why = "INVALID: " + out.v.summary();
+          else if (std::abs(out.fe_volume - out.be_volume) > out.round_off) why = "volume gap";
+        } catch (const GeometryError& e) {
+          why = std::string("GeometryError: ") + e.what();
+        } catch (const LimitError& e) {
+          why = std::string("LimitError: ") + e.what();
+        }
+        const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        std::printf("[survey] case %ld %s %.1f s\n", index, why.empty() ? "ok" : "FAILED", sec);
+        if (!why.empty()) {
+          ++failed;
+          std::printf("[survey] case %ld FAILED: %s\n  %s\n", index, test::describe(spec).c_str(), why.c_str());
+          if (dir) {
+            std::ofstream(fs::path(dir) / (k + "-" + std::to_string(index) + ".off")) << test::to_off(spec);
+          }
+        }
+        std::fflush(stdout);
+      },
+      metadata, params);
+  std::printf("[survey] %s: %ld cases, %ld failed\n", k.c_str(), n, failed);
 }
 
 // ---- shrunk counterexamples (tests/dim3/regressions/*.off), in the unit suite ----
