@@ -134,7 +134,8 @@ int run(const std::vector<std::string>& argv) {
                     {"threads", opt.n_threads},
                     {"buffer_rule_dropped", r.buffer_dropped},
                     {"feature_snapping_dropped", r.features_dropped},
-                    {"facing_projection", r.facing_projection}};
+                    {"facing_projection", r.facing_projection},
+                    {"thickness_refined", r.thickness_refined}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},
                     {"components", surface.n_components()},

@@ -69,6 +69,17 @@ struct Options3d {
   /// per run and kept only if the volume of the octants dropped as islands shrinks (a tube two
   /// octants thick: resolved; rotor's blades at level 4: more islands, the tree before it stays).
   double island_max_fraction = 0.12;
+  /// Octants wanted across the solid's thickness (SurfaceBoundary's thickness level, 0 = off),
+  /// up to level + thickness_extra_levels.
+  double thickness_cells = 0.0;
+  int thickness_extra_levels = 2;
+  /// When the mesh is valid but its volume error exceeds thin_retry_error (parts thinner than
+  /// the octants are lost), run once more with thickness_cells = thin_retry_cells and without
+  /// the buffer rule, and keep that mesh if it is valid and loses less (Result3d::
+  /// thickness_refined). 0 = off; not with thickness_cells > 0. The retry is bounded: at most 4
+  /// repairs per try and 8x the first tree's octants (1M at least); past them the first mesh stands.
+  double thin_retry_cells = 2.0;
+  double thin_retry_error = 0.05;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   int n_threads = 1;
@@ -94,6 +105,7 @@ struct Result3d {
   bool buffer_dropped = false;       ///< the run with the buffer rule failed; this one is without
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
+  bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)

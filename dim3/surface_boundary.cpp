@@ -64,13 +64,26 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
   // thinner than a few octants has no interior octant across it and falls apart (measured: rotor
   // and elephant at level 4 changed topology), so the level field asks for `thickness_cells`
   // octants across it.
-  if (options_.thickness_cells > 0) {
-    for (std::int32_t t = 0; t < nt; ++t) {
-      const double thick = thickness(t);
-      if (std::isfinite(thick) && thick > 0)
-        curvature_level_[t] = std::max(curvature_level_[t], std::log2(root_side * options_.thickness_cells / thick));
-    }
+  root_side_ = root_side;
+  set_thickness_level(options_.thickness_cells, options_.thickness_max_level);
+}
+
+const std::vector<double>& SurfaceBoundary::thicknesses() {
+  if (thickness_.empty()) {
+    thickness_.resize(surface_.n_triangles());
+    for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) thickness_[t] = thickness(t);
   }
+  return thickness_;
+}
+
+void SurfaceBoundary::set_thickness_level(double cells, double max_level) {
+  options_.thickness_cells = cells;
+  options_.thickness_max_level = max_level;
+  thickness_level_.assign(surface_.n_triangles(), -std::numeric_limits<double>::infinity());
+  if (!(cells > 0)) return;
+  const std::vector<double>& thick = thicknesses();
+  for (std::size_t t = 0; t < thick.size(); ++t)
+    if (std::isfinite(thick[t]) && thick[t] > 0) thickness_level_[t] = std::log2(root_side_ * cells / thick[t]);
 }
 
 double SurfaceBoundary::thickness(std::int32_t t) const {
@@ -289,16 +302,20 @@ Side SurfaceBoundary::classify(const Box<3>& box) const {
 }
 
 double SurfaceBoundary::control_level(const Box<3>& box) const {
-  double level = options_.global_level;
+  double level = std::min(options_.global_level, options_.max_level);
   const double feature_level = options_.global_level + options_.feature_extra_levels;
+  const double cap =
+      options_.thickness_cells > 0 ? std::max(options_.max_level, options_.thickness_max_level) : options_.max_level;
   tree_.for_each_in_box(box, [&](std::int32_t t) {
-    if (level >= options_.max_level) return;
-    const double wanted = std::max(curvature_level_[t], near_feature_[t] ? feature_level : level);
+    if (level >= cap) return;
+    const double wanted =
+        std::max(std::min(std::max(curvature_level_[t], near_feature_[t] ? feature_level : level), options_.max_level),
+                 std::min(thickness_level_[t], options_.thickness_max_level));
     if (wanted <= level) return;
     const auto& q = tree_.points(t);
     if (box_triangle_overlap(box, q[0], q[1], q[2])) level = wanted;
   });
-  return std::min(level, options_.max_level);
+  return level;
 }
 
 }  // namespace febemesh::dim3

@@ -11,8 +11,9 @@
 //     dihedral angle / the distance between its triangles' centroids (smooth edges only),
 //     averaged at each vertex, and a triangle's kappa is the mean of its vertices',
 //   - the thickness level of every triangle the box meets: log2(root side * thickness_cells /
-//     thickness), the thickness measured along the inward normal from the centroid,
-// capped by max_level (set_max_level).
+//     thickness), the thickness measured along the inward normal from the centroid, capped by
+//     thickness_max_level (set_thickness_level),
+// the others capped by max_level (set_max_level).
 
 #include <string>
 #include <vector>
@@ -33,7 +34,9 @@ struct SurfaceOptions {
   /// Octants wanted across the thickness of the solid (ray from each triangle inwards); 0 = off.
   /// Off by default: measured at level 4 it refines spool and rotor where the boundary octants
   /// then fold (spool valid without, invalid with), and elephant's topology is not fixed by it.
+  /// mesh3d sets it (Options3d::thickness_cells, thin_retry_cells): with it, no buffer rule.
   double thickness_cells = 0.0;
+  double thickness_max_level = 8.0;  ///< cap of the thickness level (set_thickness_level)
 };
 
 class SurfaceBoundary final : public Boundary<3> {
@@ -68,6 +71,11 @@ class SurfaceBoundary final : public Boundary<3> {
 
   void set_global_level(double level) { options_.global_level = level; }
   void set_max_level(double level) { options_.max_level = level; }
+  /// The thickness level's cells across (0 = off) and its cap; computes the thicknesses on
+  /// first use (not thread-safe: call before the level field is read).
+  void set_thickness_level(double cells, double max_level);
+  /// thickness(t) of every triangle, computed once.
+  const std::vector<double>& thicknesses();
   double global_level() const { return options_.global_level; }
   double max_level() const { return options_.max_level; }
   /// Thickness of the solid behind triangle t: the distance from its centroid straight inwards
@@ -90,6 +98,9 @@ class SurfaceBoundary final : public Boundary<3> {
   AabbTree tree_;
   Features features_;
   std::vector<double> curvature_level_;
+  std::vector<double> thickness_;        ///< thickness(t), when computed
+  std::vector<double> thickness_level_;  ///< -inf where thickness_cells is off or nothing is behind
+  double root_side_ = 0.0;
   std::vector<bool> near_feature_;
   double diagonal_ = 0.0;
 };

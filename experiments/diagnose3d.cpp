@@ -12,6 +12,8 @@
 //   long      - a projection longer than 1.5 face sizes;
 //   other     - all projections go out and land facing the face: shear between neighbours.
 // Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]
+// THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
+// retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
 
 #include <cmath>
 #include <cstdio>
@@ -53,6 +55,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--all") bo.outward_all_faces = true;
     if (std::string(argv[i]) == "--norays") bo.rays = false;
+    if (std::string(argv[i]) == "--snap") bo.snap_features = true;
     if (std::string(argv[i]) == "--near" && i + 4 < argc) {
       near_on = true;
       near_p = P3(std::atof(argv[i + 1]), std::atof(argv[i + 2]), std::atof(argv[i + 3]));
@@ -67,6 +70,7 @@ int main(int argc, char** argv) {
   SurfaceBoundary s = SurfaceBoundary::from_file(path, so);
   Options3d opt;
   opt.level = level;
+  opt.thickness_cells = so.thickness_cells;
   opt.min_outward = bo.min_outward;
   opt.min_facing = bo.min_facing;
   opt.outward_all_faces = bo.outward_all_faces;
@@ -82,6 +86,8 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--thin-cells") opt.thin_cells = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--island-max-fraction") opt.island_max_fraction = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--topology-refinements") opt.topology_refinements = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--extra-levels") opt.extra_levels = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--thickness-extra") opt.thickness_extra_levels = std::atoi(argv[i + 1]);
   }
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--pipeline") {
@@ -109,8 +115,9 @@ int main(int argc, char** argv) {
     }
   s.set_global_level(opt.level);
   s.set_max_level(opt.level + opt.extra_levels);
+  s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
   RefineOptions ro;
-  ro.max_level = opt.level + opt.extra_levels + 2;
+  ro.max_level = std::max(opt.level + opt.extra_levels + 2, opt.level + opt.thickness_extra_levels);
   const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
   Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
   const std::vector<Side> sides = classify(tree, s);
