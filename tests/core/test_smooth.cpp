@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
@@ -34,6 +36,29 @@ template <int Dim> Mesh<Dim> perturbed(int n, bool simplices, double amount, uns
     if (!on_grid_boundary<Dim>(p, n))
       for (int d = 0; d < Dim; ++d) p[d] += amount * next();
   return mesh;
+}
+
+/// The nearest point on a facet of the box [0, n]^Dim (boundary nodes sliding on the box).
+template <int Dim> Point<Dim> onto_box_facet(const Point<Dim>& p, int n) {
+  Point<Dim> q = p.cwiseMax(0.0).cwiseMin(double(n));
+  int best = 0;
+  double dist = 1e300;
+  for (int d = 0; d < Dim; ++d)
+    for (const double side : {0.0, double(n)})
+      if (std::abs(q[d] - side) < dist) dist = std::abs(q[d] - side), best = 2 * d + (side > 0);
+  q[best / 2] = best % 2 ? n : 0.0;
+  return q;
+}
+
+/// 1 for the nodes on the box's edges and corners (on two facets or more), which stay.
+template <int Dim> std::vector<std::uint8_t> box_edges_fixed(const Mesh<Dim>& m, int n) {
+  std::vector<std::uint8_t> fixed(m.points.size(), 0);
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    int on = 0;
+    for (int d = 0; d < Dim; ++d) on += m.points[i][d] == 0.0 || m.points[i][d] == n;
+    fixed[i] = on >= 2;
+  }
+  return fixed;
 }
 
 template <int Dim> double min_quality(const Mesh<Dim>& m) {
@@ -79,24 +104,10 @@ TEMPLATE_TEST_CASE_SIG("boundary nodes slide with a projection", "[smooth]", ((i
   REQUIRE(is_valid(mesh));
   const double q_before = min_quality(mesh);
   // Projection onto the nearest facet of the box [0, n]^Dim (n is a constant: no capture).
-  auto project = [](const Point<Dim>& p) {
-    Point<Dim> q = p.cwiseMax(0.0).cwiseMin(double(n));
-    int best = 0;
-    double dist = 1e300;
-    for (int d = 0; d < Dim; ++d)
-      for (const double side : {0.0, double(n)})
-        if (std::abs(q[d] - side) < dist) dist = std::abs(q[d] - side), best = 2 * d + (side > 0);
-    q[best / 2] = best % 2 ? n : 0.0;
-    return q;
-  };
+  auto project = [](const Point<Dim>& p) { return onto_box_facet<Dim>(p, n); };
   SmoothOptions<Dim> opt;
   opt.project = project;
-  opt.fixed.assign(mesh.points.size(), 0);
-  for (std::size_t i = 0; i < mesh.points.size(); ++i) {  // box corners and edges stay
-    int on = 0;
-    for (int d = 0; d < Dim; ++d) on += mesh.points[i][d] == 0.0 || mesh.points[i][d] == n;
-    opt.fixed[i] = on >= 2;
-  }
+  opt.fixed = box_edges_fixed(mesh, n);  // box corners and edges stay
   smooth(mesh, opt);
   ValidateOptions<Dim> vopt;
   vopt.boundary_distance = [&](const Point<Dim>& p) { return (project(p) - p).norm(); };
@@ -133,22 +144,8 @@ TEMPLATE_TEST_CASE_SIG("smoothing gives the same points on 1, 2 and 3 threads", 
       const Mesh<Dim> start = perturbed<Dim>(n, simplices, 0.3, 11);
       SmoothOptions<Dim> opt;
       if (slide) {  // boundary nodes slide on the box's facets, its edges and corners stay
-        opt.project = [n](const Point<Dim>& p) {
-          Point<Dim> q = p.cwiseMax(0.0).cwiseMin(double(n));
-          int best = 0;
-          double dist = 1e300;
-          for (int d = 0; d < Dim; ++d)
-            for (const double side : {0.0, double(n)})
-              if (std::abs(q[d] - side) < dist) dist = std::abs(q[d] - side), best = 2 * d + (side > 0);
-          q[best / 2] = best % 2 ? n : 0.0;
-          return q;
-        };
-        opt.fixed.assign(start.points.size(), 0);
-        for (std::size_t i = 0; i < start.points.size(); ++i) {
-          int on = 0;
-          for (int d = 0; d < Dim; ++d) on += start.points[i][d] == 0.0 || start.points[i][d] == n;
-          opt.fixed[i] = on >= 2;
-        }
+        opt.project = [n](const Point<Dim>& p) { return onto_box_facet<Dim>(p, n); };
+        opt.fixed = box_edges_fixed(start, n);
       }
       Mesh<Dim> one = start;
       const SmoothStats s1 = smooth(one, opt);
