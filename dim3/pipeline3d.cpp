@@ -330,12 +330,7 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, const Progress3
 
 /// |volume of the solid elements - the surface's| / the surface's.
 double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {
-  double v = 0.0;
-  for (std::size_t e = 0; e < m.solid.size(); ++e) {
-    const auto pts = element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, m.points);
-    v += signed_measure<3>(m.solid.type[e], pts.span());
-  }
-  return std::abs(v - s.volume()) / std::abs(s.volume());
+  return std::abs(solid_measure<3>(m) - s.volume()) / std::abs(s.volume());
 }
 
 }  // namespace
