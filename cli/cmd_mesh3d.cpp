@@ -48,10 +48,15 @@ const char* help_text =
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
+    "  --effort X          work bound: the repairs and retries may build on at most X\n"
+    "                      times the first octree's octants, 2*10^6 at least, in all\n"
+    "                      (1..1000, default 60); past it the last valid mesh stands,\n"
+    "                      or the run is refused\n"
     "  --allow-invalid     write the mesh even if validation fails (exit status 1 still)\n"
     "  --quiet             no progress on stderr\n\n"
     "Bad input (open, non-manifold or self-intersecting surface, unreadable file) exits with\n"
-    "status 1 and writes nothing.\n";
+    "status 1 and writes nothing; so does a surface whose boundary octants cannot be built\n"
+    "up to the maximum level or within the work bound.\n";
 
 nlohmann::json quality_json(const QualitySummary& q) {
   nlohmann::json j;
@@ -84,7 +89,7 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--allow-invalid"},
-                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads"});
+                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -95,6 +100,7 @@ int run(const std::vector<std::string>& argv) {
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
   opt.snap_features = !args.has("--no-features");
+  opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
@@ -109,7 +115,14 @@ int run(const std::vector<std::string>& argv) {
   dim3::SurfaceBoundary surface = dim3::SurfaceBoundary::from_file(input);
   const double t_read = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  dim3::Result3d r = dim3::mesh3d(surface, opt, progress);
+  dim3::Result3d r;
+  try {
+    r = dim3::mesh3d(surface, opt, progress);
+  } catch (const LimitError& e) {
+    throw LimitError(input + ": " + e.what());
+  } catch (const GeometryError& e) {
+    throw GeometryError(input + ": " + e.what());
+  }
   const Mesh<3>& mesh = r.fe.mesh;
 
   progress("validating " + std::to_string(mesh.solid.size()) + " tetrahedra");
@@ -168,6 +181,7 @@ int run(const std::vector<std::string>& argv) {
                    {"snaps_reverted", r.n_snaps_reverted},
                    {"degenerate_cones_dropped", r.fe.n_dropped_degenerate},
                    {"repairs", r.n_repairs},
+                   {"octants_built", r.n_octants_built},
                    {"smoothing_accepted", r.n_smoothing_accepted},
                    {"smoothing_rejected", r.n_smoothing_rejected}};
   nlohmann::json times = nlohmann::json::object();

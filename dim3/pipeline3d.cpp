@@ -246,7 +246,14 @@ std::vector<P3> nodes_behind(const Orthtree<3>& t, const OctantComplex& oc, cons
   return out;
 }
 
-Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress);
+/// The work of one run in octants built on, and its bound (Options3d::effort): 0 until the
+/// first tree is known.
+struct Effort {
+  std::size_t used = 0;
+  std::size_t limit = 0;
+};
+
+Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress);
 
 /// Volume of the leaves kept `before` keep_largest_components and dropped by it (`after`).
 double island_volume(const Orthtree<3>& t, const Flags& before, const Flags& after) {
@@ -271,8 +278,8 @@ Result3d with_fallback(const Run& run, const Options3d& opt, const Options3d& fa
   }
 }
 
-Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  const auto once = [&](const Options3d& o) { return mesh3d_once(s, o, progress); };
+Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
+  const auto once = [&](const Options3d& o) { return mesh3d_once(s, o, effort, progress); };
   if (!opt.snap_features || s.features().n_feature_edges() == 0) return once(opt);
   // Feature snapping pulls nodes across octants; on coarsely faceted surfaces (every edge a
   // feature: tori of 8 segments) it leaves tetrahedra no node move can unfold, where the plain
@@ -282,8 +289,8 @@ Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, const Progres
   return with_fallback(once, opt, plain, "without feature snapping", &Result3d::features_dropped, progress);
 }
 
-Result3d mesh3d_buffer(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  const auto features = [&](const Options3d& o) { return mesh3d_features(s, o, progress); };
+Result3d mesh3d_buffer(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
+  const auto features = [&](const Options3d& o) { return mesh3d_features(s, o, effort, progress); };
   if (opt.buffer <= 0 || !opt.retry_without_buffer) return features(opt);
   // The buffer rule drops interior octants near the surface; in a part two octants thick it
   // leaves a slab one octant wide whose rim nodes are nearer the far sheet than their own:
@@ -307,8 +314,8 @@ ValidateOptions<3> surface_validation(const SurfaceBoundary& s) {
 
 namespace {
 
-Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  const auto buffer = [&](const Options3d& o) { return mesh3d_buffer(s, o, progress); };
+Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
+  const auto buffer = [&](const Options3d& o) { return mesh3d_buffer(s, o, effort, progress); };
   if (!opt.retry_facing) return buffer(opt);
   // Thin lips (fandisk): a node's closest point can lie on the far sheet or run back along the
   // interior octants, folding its boundary octants, and refining moves the folds. The last
@@ -336,7 +343,9 @@ double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {
 }  // namespace
 
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  Result3d r = mesh3d_facing(s, opt, progress);
+  Effort effort;
+  Result3d r = mesh3d_facing(s, opt, effort, progress);
+  r.n_octants_built = effort.used;
   if (!(opt.thin_retry_cells > 0) || opt.thickness_cells > 0) return r;
   const double error = volume_error(r.fe.mesh, s);
   if (!(error > opt.thin_retry_error)) return r;
@@ -354,16 +363,20 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   // tree it multiplies the octants (rotor L4: 37927 -> 116145 -> 311522 over the repairs, 2.5
   // CPU minutes, refused), while its first tree's mesh may already lose less.
   thin.topology_refinements = 0;
-  // A bounded retry: a few repairs per try, and at most 8x the first tree's octants (1M at
-  // least). Unbounded, rotor L5's retry ran for more than 17 CPU minutes without a mesh; past
-  // the bounds the first mesh stands.
+  // A bounded retry: a few repairs per try, trees of at most 8x the first tree's octants (1M
+  // at least), and its own work bound of thin_retry_effort. Unbounded, rotor L5's retry ran for
+  // more than 17 CPU minutes without a mesh; past the bounds the first mesh stands.
   thin.max_repairs = std::min(opt.max_repairs, 4);
   thin.max_cells = std::min(opt.max_cells, std::max<std::size_t>(8 * r.tree.n_leaves(), std::size_t{1} << 20));
+  thin.effort = std::min(opt.effort, opt.thin_retry_effort);
+  thin.min_effort_octants = 0;
   if (progress)
     progress("volume error " + std::to_string(100 * error) + "%: once more with " + std::to_string(thin.thickness_cells) +
              " octants across the thin parts, without the buffer rule");
+  Effort thin_effort;
   try {
-    Result3d t = mesh3d_facing(s, thin, progress);
+    Result3d t = mesh3d_facing(s, thin, thin_effort, progress);
+    t.n_octants_built = r.n_octants_built + thin_effort.used;
     const ValidationReport v = validate(t.fe.mesh, surface_validation(s));
     const double t_error = volume_error(t.fe.mesh, s);
     if (progress)
@@ -382,12 +395,13 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     if (progress) progress(std::string("thin parts: over the retry's bounds (") + e.what() + "); keeping the first mesh");
   }
   s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+  r.n_octants_built += thin_effort.used;
   return r;
 }
 
 namespace {
 
-Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   auto say = [&](const std::string& msg) {
     if (progress) progress(msg);
   };
@@ -416,6 +430,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
   // level of hanging nodes, which the face templates assume.
   tree = balance_2to1(tree, BalanceKind::Full);
   clock.lap("balance");
+  if (effort.limit == 0)
+    effort.limit = std::max(static_cast<std::size_t>(opt.effort * static_cast<double>(tree.n_leaves())),
+                            opt.min_effort_octants);
 
   const SurfacePointFn surface_point = [&](const P3& p) {
     const ClosestPoint<3> cp = s.closest_point(p);
@@ -437,6 +454,19 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
     TetMesh fe;
   };
   std::optional<Saved> saved;  // the last valid mesh whose topology a refinement tries to fix
+  // The valid coarser mesh in `saved` stands (with its volume warning) when the finer tree's
+  // cannot be built.
+  const auto restore_saved = [&]() {
+    std::vector<StageTime3> times = std::move(r.times);
+    r = std::move(saved->r);
+    r.times = std::move(times);
+    if (opt.hex_dominant) r.hex = make_hex_dominant(saved->tree, saved->oc.complex, saved->fe, opt.hex);
+    r.stats = saved->oc.stats;
+    r.fe = std::move(saved->fe);
+    r.interior = std::move(saved->in);
+    r.tree = std::move(saved->tree);
+    return std::move(r);
+  };
   int island_refinements = 0;
   // An island refinement above island_max_fraction is tried once: kept when the volume of the
   // octants dropped as islands shrinks (the thin part is resolved: tori at level 3, whose whole
@@ -521,6 +551,21 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
         std::to_string(r.n_islands_dropped) + " in islands");
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
 
+    // The work bound counts the trees the construction below is built on: it, the untangling
+    // and the smoothing cost about the same per octant on every try (the classification and
+    // the island refinements above are cheaper).
+    effort.used += tree.n_leaves();
+    if (effort.used > effort.limit) {
+      const std::string why = "building on " + std::to_string(tree.n_leaves()) + " more octants would bring this run to " +
+                              std::to_string(effort.used) + ", over its work bound of " + std::to_string(effort.limit) +
+                              " (" + std::to_string(static_cast<int>(opt.effort)) + "x the first tree's octants, --effort)";
+      if (saved) {
+        say("repair " + std::to_string(attempt + 1) + ": " + why + "; keeping the mesh before the refinement");
+        return restore_saved();
+      }
+      throw LimitError("the boundary octants could not be built within the work bound: " + why + ", after " +
+                       std::to_string(r.n_repairs) + " repair(s); try another --level");
+    }
     say("boundary octants: projecting the free faces onto the surface");
     BoundaryOctantOptions bo;
     bo.snap_features = opt.snap_features;
@@ -728,15 +773,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, const Progress3& 
       // warning), rather than no mesh.
       say("repair " + std::to_string(attempt + 1) + ": the refined tree has " + std::to_string(problems.size()) +
           " problem(s) (" + describe(problems) + "); keeping the mesh before the refinement");
-      std::vector<StageTime3> times = std::move(r.times);
-      r = std::move(saved->r);
-      r.times = std::move(times);
-      if (opt.hex_dominant) r.hex = make_hex_dominant(saved->tree, saved->oc.complex, saved->fe, opt.hex);
-      r.stats = saved->oc.stats;
-      r.fe = std::move(saved->fe);
-      r.interior = std::move(saved->in);
-      r.tree = std::move(saved->tree);
-      return r;
+      return restore_saved();
     }
     if (stuck)
       throw GeometryError("the boundary octants cannot be built (" + std::to_string(problems.size()) +

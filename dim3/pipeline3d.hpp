@@ -80,8 +80,19 @@ struct Options3d {
   /// repairs per try and 8x the first tree's octants (1M at least); past them the first mesh stands.
   double thin_retry_cells = 2.0;
   double thin_retry_error = 0.05;
+  /// The retry's own work bound (`effort` for it, without min_effort_octants): it only improves
+  /// a valid mesh, so it gets less room than the first run (rotor L4: its 3 tries on 198k-313k
+  /// octants cost 190 s CPU on top of the first run's 70 s, and lost as much volume).
+  double thin_retry_effort = 10.0;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
+  /// The work bound, so that no input runs for ever: the octants of every tree the boundary
+  /// octants are built on add up, over all the tries of one run (the thickness retry has its
+  /// own count), to at most `effort` times the first tree's (`min_effort_octants` at least).
+  /// Past it the last valid mesh of the try stands, or LimitError. A build costs about the same
+  /// per octant on every try, so `effort` is about the run's cost in first builds.
+  double effort = 60.0;
+  std::size_t min_effort_octants = 2000000;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;
@@ -102,6 +113,7 @@ struct Result3d {
   std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes
   std::size_t n_snaps_reverted = 0;  ///< feature snaps undone because they inverted an element
   int n_repairs = 0;
+  std::size_t n_octants_built = 0;   ///< octants of every tree built on, over all tries (Options3d::effort)
   bool buffer_dropped = false;       ///< the run with the buffer rule failed; this one is without
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules

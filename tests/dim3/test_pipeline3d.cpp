@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <string>
 
+#include "core/error.hpp"
 #include "core/quality.hpp"
 #include "core/validate.hpp"
 #include "dim3/fidelity3d.hpp"
@@ -54,6 +55,36 @@ TEST_CASE("mesh3d refuses an open surface with exit 1 and writes nothing", "[pip
   CHECK(WEXITSTATUS(status) == 1);
   CHECK_FALSE(std::filesystem::exists(out));
   std::filesystem::remove(out.string() + ".err");
+}
+
+// The work bound (Options3d::effort): the coarse perturbed sphere of the regressions needs 3
+// repairs with feature snapping, then meshes without it (3088 + 5461 + 8856 + 11775 + 3088 =
+// 32268 octants built on, measured). A bound of twice the first tree (6176) stops it at the
+// first repair's tree, where no valid mesh is at hand: LimitError, naming the bound.
+TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeline3d]") {
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/sphere-coarse-inverted-element.off";
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  opt.min_effort_octants = 0;
+  {
+    SurfaceBoundary s = SurfaceBoundary::from_file(file);
+    const Result3d r = mesh3d(s, opt);
+    CHECK(r.features_dropped);
+    CHECK(r.n_octants_built > 3 * r.n_leaves_subdivided);
+    CHECK(r.n_octants_built <= static_cast<std::size_t>(opt.effort * static_cast<double>(r.n_leaves_subdivided)));
+    CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+  }
+  opt.effort = 2.0;
+  SurfaceBoundary s = SurfaceBoundary::from_file(file);
+  std::string what;
+  try {
+    mesh3d(s, opt);
+  } catch (const LimitError& e) {
+    what = e.what();
+  }
+  INFO(what);
+  CHECK(what.find("over its work bound of 6176") != std::string::npos);
 }
 
 // tet_optimize: a cube split into 12 cones from a centre node; the centre pushed out of the cube
