@@ -1,5 +1,5 @@
-// `febemesh mesh3d --threads`: the same mesh for every thread count; out-of-range counts are
-// bad usage.
+// `febemesh mesh3d --threads`: the same mesh for every thread count; out-of-range counts (and
+// work bounds) are bad usage.
 
 #include <catch2/catch.hpp>
 #include <filesystem>
@@ -36,6 +36,10 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
   CHECK(one.size() > 1000);
   CHECK(one == two);
   CHECK(nlohmann::json::parse(read_text(dir / "2" / "report.json"))["options"]["threads"] == 2);
+  // The work bound's count: one tree built on (sphere966 L4 needs no repair).
+  const auto counts = nlohmann::json::parse(read_text(dir / "1" / "report.json"))["counts"];
+  CHECK(counts["octants_built"] == counts["leaves"]);
+  CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --effort 0.5") == 2);
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --threads 0") == 2);
   CHECK(!std::filesystem::exists(dir / "0"));
   std::filesystem::remove_all(dir);
