@@ -158,8 +158,8 @@ std::vector<FacetUse> unsorted_uses(const Elements& els) {
     const ElemId id{static_cast<std::int32_t>(e)};
     const ElemType t = els.type[e];
     if (t == ElemType::Tri3 || t == ElemType::Quad4) {
-      // Facets (k, k+1): key and orientation read off the nodes, without the tables (the
-      // generic calls were two thirds of facet_uses on a 2D mesh: flange level 9, 228M).
+      // Facets (k, k+1): key and orientation read off the nodes, without the tables' calls
+      // (facet_uses at flange level 9: 228M -> 120M instructions).
       const int n = t == ElemType::Tri3 ? 3 : 4;
       const VertexId* v = els.nodes(id);
       for (int f = 0; f < n; ++f) {
