@@ -282,9 +282,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // A pass looks triangles up at the start's connectivity: its flips (e0, e1, a, b, c, d) update
   // the incidence after it (a flipped triangle is `touched` and skipped until then anyway).
   std::vector<std::array<std::int32_t, 6>> flipped;
-  // seen[w] == visit: w is already among the neighbours gathered in this visit.
-  std::vector<std::uint32_t> seen(n_nodes, 0);
-  std::uint32_t visit = 0;
+  std::vector<std::uint8_t> listed(n_nodes, 0);  // w is among the neighbours being gathered
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
   // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
   // has any of its elements flipped since; its target, its elements' angles and the trial
@@ -373,7 +371,6 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         // The distinct edge neighbours, ascending (the centroid below sums them in that order).
         nb.clear();
         const auto self = static_cast<std::int32_t>(v);
-        if (++visit == 0) std::fill(seen.begin(), seen.end(), 0), visit = 1;
         for (const std::int32_t e : elems) {
           const ElemId id{e};
           const int n = m.solid.n_nodes_of(id);
@@ -381,11 +378,13 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
           for (int k = 0; k < n; ++k) {
             if (ev[k].v != self) continue;
             for (const std::int32_t w : {ev[(k + 1) % n].v, ev[(k + n - 1) % n].v})
-              if (seen[w] != visit) seen[w] = visit, nb.push_back(w);
+              if (!listed[w]) listed[w] = 1, nb.push_back(w);
           }
         }
-        for (std::size_t i = 1; i < nb.size(); ++i)
+        for (std::size_t i = 0; i < nb.size(); ++i) {
+          listed[nb[i]] = 0;
           for (std::size_t j = i; j > 0 && nb[j] < nb[j - 1]; --j) std::swap(nb[j], nb[j - 1]);
+        }
       }
       if (nb.empty()) continue;
       P2 target = P2::Zero();
