@@ -139,52 +139,52 @@ namespace {
 
 /// Node -> incident elements, kept up to date under edge flips instead of rebuilt for every
 /// flip pass and smoothing round (flange level 9: 13 rebuilds, each two sweeps over all
-/// elements, were 15% of this stage's instructions). A list's order is not kept (removal swaps
-/// in the last): every use below reads a list as a set (the flip pass finds an edge's two
+/// elements, were 15% of this stage's instructions). A list's order is not kept (removal moves
+/// the last in): every use below reads a list as a set (the flip pass finds an edge's two
 /// triangles and orders them by id; the smoothing's decisions are over all of a node's
-/// elements, its sums over its sorted neighbours). Each list has room for two more; a full one
-/// moves to the end with twice the room.
+/// elements, its sums over its sorted neighbours). CSR with two spare slots per node, unused
+/// slots -1, and no per-node counts: with counts and room per node (12 B/node more) this stage
+/// was the memory peak at flange level 10 (120 B/element; now 104). A flip that finds a list
+/// full has everything rebuilt from the mesh (one spare slot: 4 rebuilds at flange level 9,
+/// +200M instructions; two: none, 1.17G for the stage against 1.44G before the live lists).
 class LiveIncidence {
  public:
-  explicit LiveIncidence(const Mesh<2>& m) : first_(m.points.size(), 0), size_(m.points.size(), 0), room_(m.points.size()) {
-    for (const VertexId v : m.solid.node) ++size_[v.v];
-    std::int32_t at = 0;
-    for (std::size_t v = 0; v < first_.size(); ++v) {
-      first_[v] = at;
-      room_[v] = size_[v] + 2;
-      at += room_[v];
-      size_[v] = 0;
-    }
-    elem_.resize(static_cast<std::size_t>(at));
-    for (std::size_t e = 0; e < m.solid.size(); ++e) {
-      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
-      for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k, ++v) add(v->v, static_cast<std::int32_t>(e));
-    }
+  explicit LiveIncidence(const Mesh<2>& m) { rebuild(m); }
+  void rebuild(const Mesh<2>& m) {
+    first_.assign(m.points.size() + 1, 0);
+    for (const VertexId v : m.solid.node) ++first_[static_cast<std::size_t>(v.v) + 1];
+    for (std::size_t v = 0; v + 1 < first_.size(); ++v) first_[v + 1] += first_[v] + spare;
+    elem_.assign(static_cast<std::size_t>(first_.back()), -1);
+    for (std::size_t e = 0; e < m.solid.size(); ++e)
+      for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k) add(m.solid.node[k].v, static_cast<std::int32_t>(e));
   }
   std::span<const std::int32_t> of(std::int32_t v) const {
-    return {elem_.data() + first_[v], static_cast<std::size_t>(size_[v])};
+    const std::int32_t* list = elem_.data() + first_[v];
+    std::size_t n = 0;
+    const auto room = static_cast<std::size_t>(first_[v + 1] - first_[v]);
+    while (n < room && list[n] >= 0) ++n;
+    return {list, n};
   }
-  void add(std::int32_t v, std::int32_t e) {
-    if (size_[v] == room_[v]) {
-      const auto at = static_cast<std::int32_t>(elem_.size());
-      elem_.resize(elem_.size() + 2 * static_cast<std::size_t>(room_[v]));
-      std::copy_n(elem_.begin() + first_[v], size_[v], elem_.begin() + at);
-      first_[v] = at;
-      room_[v] *= 2;
-    }
-    elem_[static_cast<std::size_t>(first_[v] + size_[v]++)] = e;
+  /// False (and nothing changed) when v's list is full.
+  bool add(std::int32_t v, std::int32_t e) {
+    for (std::int32_t k = first_[v]; k < first_[v + 1]; ++k)
+      if (elem_[static_cast<std::size_t>(k)] < 0) return elem_[static_cast<std::size_t>(k)] = e, true;
+    return false;
   }
   /// Requires e in v's list.
   void remove(std::int32_t v, std::int32_t e) {
     std::int32_t* list = elem_.data() + first_[v];
+    const auto n = static_cast<std::int32_t>(of(v).size());
     std::int32_t k = 0;
     while (list[k] != e) ++k;
-    MESH_ASSERT(k < size_[v], "element " << e << " not at node " << v);
-    list[k] = list[--size_[v]];
+    MESH_ASSERT(k < n, "element " << e << " not at node " << v);
+    list[k] = list[n - 1];
+    list[n - 1] = -1;
   }
 
  private:
-  std::vector<std::int32_t> first_, size_, room_, elem_;
+  static constexpr std::int32_t spare = 2;
+  std::vector<std::int32_t> first_, elem_;
 };
 
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
@@ -353,8 +353,11 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
       // (c, a, d) lost b and gained d; (d, b, c) lost a and gained c.
       for (const auto& [e0, e1, a, b, c, d] : flipped) {
-        incident.remove(b, e0), incident.add(d, e0);
-        incident.remove(a, e1), incident.add(c, e1);
+        incident.remove(b, e0), incident.remove(a, e1);
+        if (!incident.add(d, e0) || !incident.add(c, e1)) {  // a full list: the mesh has them all
+          incident.rebuild(m);
+          break;
+        }
       }
       st.flips += flips;
       if (flips == 0) break;
