@@ -27,7 +27,7 @@ class Sink : public SpillBuffer {
   /// The bytes of a trivially copyable value (the writer runs on little-endian hosts only).
   template <class T> void raw(const T& v) {
     static_assert(std::is_trivially_copyable_v<T>);
-    buf_.append(reinterpret_cast<const char*>(&v), sizeof v);
+    put(std::string_view(reinterpret_cast<const char*>(&v), sizeof v));
   }
   /// A field of the file's int type: text followed by `sep`, or 4 raw bytes.
   Sink& i32(int v, char sep = ' ') {
@@ -48,16 +48,16 @@ class Sink : public SpillBuffer {
   }
   /// Ends a line of text (nothing in binary, where fields have no separators).
   Sink& eol() {
-    if (!binary_) buf_.push_back('\n');
+    if (!binary_) put('\n');
     return *this;
   }
   Sink& operator<<(std::string_view s) {
-    buf_.append(s);
+    put(s);
     maybe_flush();
     return *this;
   }
   Sink& operator<<(char c) {
-    buf_.push_back(c);
+    put(c);
     return *this;
   }
   template <class Int> Sink& integer(Int v) {

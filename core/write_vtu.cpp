@@ -24,12 +24,12 @@ class Text : public SpillBuffer {
   explicit Text(std::FILE* file = nullptr, std::string path = {})
       : SpillBuffer(file, std::move(path), file ? chunk + (1 << 16) : 0) {}
   Text& operator<<(std::string_view s) {
-    buf_.append(s);
+    put(s);
     return *this;
   }
   template <class Num> Text& num(Num v) {
     append_number(v);
-    buf_.push_back(' ');
+    put(' ');
     return *this;
   }
 };

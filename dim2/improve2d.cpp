@@ -137,68 +137,54 @@ double min_corner_angle_deg_ref(const Mesh<2>& m, std::size_t e) {
 
 namespace {
 
-/// Node -> incident elements in CSR form (elements in increasing order), optionally only the
-/// triangles.
-struct Incidence {
-  std::vector<std::int32_t> start, elem;
-  Incidence(const Mesh<2>& m, bool triangles_only) : start(m.points.size() + 1, 0) {
-    auto counted = [&](std::size_t e) { return !triangles_only || m.solid.type[e] == ElemType::Tri3; };
-    for (std::size_t e = 0; e < m.solid.size(); ++e) {
-      if (!counted(e)) continue;
-      const ElemId id{static_cast<std::int32_t>(e)};
-      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) ++start[m.solid.nodes(id)[k].v + 1];
-    }
-    for (std::size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
-    elem.resize(start.back());
-    std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t e = 0; e < m.solid.size(); ++e) {
-      if (!counted(e)) continue;
-      const ElemId id{static_cast<std::int32_t>(e)};
-      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) elem[fill[m.solid.nodes(id)[k].v]++] = id.v;
-    }
-  }
-  std::span<const std::int32_t> of(std::int32_t v) const {
-    return {elem.data() + start[v], static_cast<std::size_t>(start[v + 1] - start[v])};
-  }
-};
-
-/// The triangles at some of the nodes (CSR over those nodes only, triangles in increasing
-/// order, as Incidence(m, true) lists them): a flip pass looks up only the smaller ends of its
-/// candidate edges, the boundary layer, so it need not index every node.
-class SomeTriangles {
+/// Node -> incident elements, kept up to date under edge flips instead of rebuilt for every
+/// flip pass and smoothing round (flange level 9: 13 rebuilds, each two sweeps over all
+/// elements, were 15% of this stage's instructions). A list's order is not kept (removal moves
+/// the last in): every use below reads a list as a set (the flip pass finds an edge's two
+/// triangles and orders them by id; the smoothing's decisions are over all of a node's
+/// elements, its sums over its sorted neighbours). CSR with two spare slots per node, unused
+/// slots -1, and no per-node counts: with counts and room per node (12 B/node more) this stage
+/// was the memory peak at flange level 10 (120 B/element; now 104). A flip that finds a list
+/// full has everything rebuilt from the mesh (one spare slot: 4 rebuilds at flange level 9,
+/// +200M instructions; two: none, 1.17G for the stage against 1.44G before the live lists).
+class LiveIncidence {
  public:
-  explicit SomeTriangles(std::size_t n_nodes) : slot_(n_nodes, -1) {}
-  /// Rebuilds the lists for `nodes` (distinct) from the triangles of m.
-  void build(const Mesh<2>& m, const std::vector<std::int32_t>& nodes) {
-    for (const std::int32_t v : nodes_) slot_[v] = -1;
-    nodes_ = nodes;
-    for (std::size_t i = 0; i < nodes_.size(); ++i) slot_[nodes_[i]] = static_cast<std::int32_t>(i);
-    start_.assign(nodes_.size() + 1, 0);
-    for (std::size_t e = 0; e < m.solid.size(); ++e) {
-      if (m.solid.type[e] != ElemType::Tri3) continue;
-      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
-      for (int k = 0; k < 3; ++k)
-        if (const std::int32_t s = slot_[v[k].v]; s >= 0) ++start_[s + 1];
-    }
-    for (std::size_t i = 0; i < nodes_.size(); ++i) start_[i + 1] += start_[i];
-    elem_.resize(start_.back());
-    fill_.assign(start_.begin(), start_.end() - 1);
-    for (std::size_t e = 0; e < m.solid.size(); ++e) {
-      if (m.solid.type[e] != ElemType::Tri3) continue;
-      const VertexId* v = m.solid.node.data() + m.solid.offset[e];
-      for (int k = 0; k < 3; ++k)
-        if (const std::int32_t s = slot_[v[k].v]; s >= 0) elem_[fill_[s]++] = static_cast<std::int32_t>(e);
-    }
+  explicit LiveIncidence(const Mesh<2>& m) { rebuild(m); }
+  void rebuild(const Mesh<2>& m) {
+    first_.assign(m.points.size() + 1, 0);
+    for (const VertexId v : m.solid.node) ++first_[static_cast<std::size_t>(v.v) + 1];
+    for (std::size_t v = 0; v + 1 < first_.size(); ++v) first_[v + 1] += first_[v] + spare;
+    elem_.assign(static_cast<std::size_t>(first_.back()), -1);
+    for (std::size_t e = 0; e < m.solid.size(); ++e)
+      for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k) add(m.solid.node[k].v, static_cast<std::int32_t>(e));
   }
-  /// Requires v among the nodes of the last build.
   std::span<const std::int32_t> of(std::int32_t v) const {
-    const std::int32_t s = slot_[v];
-    MESH_ASSERT(s >= 0, "node " << v << " not indexed");
-    return {elem_.data() + start_[s], static_cast<std::size_t>(start_[s + 1] - start_[s])};
+    const std::int32_t* list = elem_.data() + first_[v];
+    std::size_t n = 0;
+    const auto room = static_cast<std::size_t>(first_[v + 1] - first_[v]);
+    while (n < room && list[n] >= 0) ++n;
+    return {list, n};
+  }
+  /// False (and nothing changed) when v's list is full.
+  bool add(std::int32_t v, std::int32_t e) {
+    for (std::int32_t k = first_[v]; k < first_[v + 1]; ++k)
+      if (elem_[static_cast<std::size_t>(k)] < 0) return elem_[static_cast<std::size_t>(k)] = e, true;
+    return false;
+  }
+  /// Requires e in v's list.
+  void remove(std::int32_t v, std::int32_t e) {
+    std::int32_t* list = elem_.data() + first_[v];
+    const auto n = static_cast<std::int32_t>(of(v).size());
+    std::int32_t k = 0;
+    while (list[k] != e) ++k;
+    MESH_ASSERT(k < n, "element " << e << " not at node " << v);
+    list[k] = list[n - 1];
+    list[n - 1] = -1;
   }
 
  private:
-  std::vector<std::int32_t> slot_, nodes_, start_, elem_, fill_;
+  static constexpr std::int32_t spare = 2;
+  std::vector<std::int32_t> first_, elem_;
 };
 
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
@@ -292,8 +278,11 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact(e); }, 0.0);
   };
   std::vector<EdgeKey> candidates;
-  std::vector<std::int32_t> lows;  // the candidates' smaller ends (distinct: keys are sorted)
-  SomeTriangles tris(n_nodes);
+  LiveIncidence incident(m);
+  // A pass looks triangles up at the start's connectivity: its flips (e0, e1, a, b, c, d) update
+  // the incidence after it (a flipped triangle is `touched` and skipped until then anyway).
+  std::vector<std::array<std::int32_t, 6>> flipped;
+  std::vector<std::uint8_t> listed(n_nodes, 0);  // w is among the neighbours being gathered
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
   // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
   // has any of its elements flipped since; its target, its elements' angles and the trial
@@ -315,17 +304,15 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
       // are skipped for the rest of the pass.
-      lows.clear();
-      for (const EdgeKey key : candidates)
-        if (const auto lo = static_cast<std::int32_t>(key >> 32); lows.empty() || lows.back() != lo) lows.push_back(lo);
-      tris.build(m, lows);
+      flipped.clear();
       std::fill(touched.begin(), touched.end(), 0);
       std::size_t flips = 0;
       for (const EdgeKey key : candidates) {
         const auto lo = static_cast<std::int32_t>(key >> 32), hi = static_cast<std::int32_t>(key & 0xffffffffu);
         std::int32_t pair[2];
         int n_pair = 0;
-        for (const std::int32_t e : tris.of(lo)) {
+        for (const std::int32_t e : incident.of(lo)) {
+          if (m.solid.type[static_cast<std::size_t>(e)] != ElemType::Tri3) continue;
           if (local_edge(m.solid.nodes(ElemId{e}), lo, hi) < 0) continue;
           if (n_pair < 2) pair[n_pair] = e;
           ++n_pair;
@@ -361,14 +348,22 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
         cot[e0] = tc[2];
         cot[e1] = tc[3];
+        flipped.push_back({e0, e1, a, b, c, d});
         ++flips;
+      }
+      // (c, a, d) lost b and gained d; (d, b, c) lost a and gained c.
+      for (const auto& [e0, e1, a, b, c, d] : flipped) {
+        incident.remove(b, e0), incident.remove(a, e1);
+        if (!incident.add(d, e0) || !incident.add(c, e1)) {  // a full list: the mesh has them all
+          incident.rebuild(m);
+          break;
+        }
       }
       st.flips += flips;
       if (flips == 0) break;
     }
 
     // ---- guarded smoothing on the smallest angle ----
-    const Incidence incident(m, false);
     for (std::size_t v = 0; v < n_nodes; ++v) {
       const bool sliding = locked[v] == 2 && slide;
       const auto elems = incident.of(static_cast<std::int32_t>(v));
@@ -376,19 +371,23 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       if (sliding) {
         nb.assign(curve_neighbours.of(v).begin(), curve_neighbours.of(v).end());
       } else {
+        // The distinct edge neighbours, ascending (the centroid below sums them in that order).
         nb.clear();
+        const auto self = static_cast<std::int32_t>(v);
         for (const std::int32_t e : elems) {
           const ElemId id{e};
           const int n = m.solid.n_nodes_of(id);
           const VertexId* ev = m.solid.nodes(id);
           for (int k = 0; k < n; ++k) {
-            if (ev[k].v != static_cast<std::int32_t>(v)) continue;
-            nb.push_back(ev[(k + 1) % n].v);
-            nb.push_back(ev[(k + n - 1) % n].v);
+            if (ev[k].v != self) continue;
+            for (const std::int32_t w : {ev[(k + 1) % n].v, ev[(k + n - 1) % n].v})
+              if (!listed[w]) listed[w] = 1, nb.push_back(w);
           }
         }
-        std::sort(nb.begin(), nb.end());
-        nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+        for (std::size_t i = 0; i < nb.size(); ++i) {
+          listed[nb[i]] = 0;
+          for (std::size_t j = i; j > 0 && nb[j] < nb[j - 1]; --j) std::swap(nb[j], nb[j - 1]);
+        }
       }
       if (nb.empty()) continue;
       P2 target = P2::Zero();

@@ -56,8 +56,12 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
     }
   }
-  // Edge neighbours of each node from its incident elements (each node's few, sorted locally).
+  // Edge neighbours of each node from its incident elements (each node's few, sorted locally):
+  // duplicates are caught by a mark, cleared after the node, and the list insertion-sorted
+  // (std::sort and std::unique per node: optimise_angles 428M -> 388M instructions at flange
+  // level 9).
   std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
+  std::vector<std::uint8_t> listed(n_nodes, 0);
   nbr.reserve(first.back());
   for (std::size_t v = 0; v < n_nodes; ++v) {
     const std::size_t begin = nbr.size();
@@ -67,12 +71,14 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       const VertexId* ev = m.solid.nodes(id);
       for (int j = 0; j < n; ++j) {
         if (ev[j].v != static_cast<std::int32_t>(v)) continue;
-        nbr.push_back(ev[(j + 1) % n].v);
-        nbr.push_back(ev[(j + n - 1) % n].v);
+        for (const std::int32_t w : {ev[(j + 1) % n].v, ev[(j + n - 1) % n].v})
+          if (!listed[w]) listed[w] = 1, nbr.push_back(w);
       }
     }
-    std::sort(nbr.begin() + std::ptrdiff_t(begin), nbr.end());
-    nbr.erase(std::unique(nbr.begin() + std::ptrdiff_t(begin), nbr.end()), nbr.end());
+    for (std::size_t i = begin; i < nbr.size(); ++i) {
+      listed[nbr[i]] = 0;
+      for (std::size_t j = i; j > begin && nbr[j] < nbr[j - 1]; --j) std::swap(nbr[j], nbr[j - 1]);
+    }
     nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
   }
 

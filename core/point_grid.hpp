@@ -1,0 +1,93 @@
+#pragma once
+// A uniform grid over a subset of the points (bucketed by counting sort), for box queries of
+// about the size of the local spacing: the 2D validator asks one per edge of the mesh. The
+// k-d tree it replaced there visited far more nodes than it reported, because the lattice
+// nodes share coordinates with its split values (flange level 9, 3.4e5 triangles: 1.4e9
+// instructions for the edge and duplicate queries and the build).
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/box.hpp"
+
+namespace febemesh {
+
+template <int Dim> class PointGrid {
+ public:
+  /// Buckets pts[id] for id in ids (any order) into about ids.size() square cells.
+  PointGrid(const std::vector<Point<Dim>>& pts, const std::vector<std::int32_t>& ids) : pts_(pts) {
+    Box<Dim> b = Box<Dim>::empty();
+    for (const std::int32_t id : ids)
+      if (pts[id].allFinite()) b.expand(pts[id]);
+    lo_ = b.lo;
+    const Point<Dim> ext = b.hi - b.lo;
+    const double big = ext.allFinite() ? ext.maxCoeff() : 0.0;
+    std::size_t n_cells = 1;
+    for (int d = 0; d < Dim; ++d) k_[d] = 1, inv_[d] = 0.0;
+    if (big > 0 && !ids.empty()) {
+      // Square cells, about one point each: side s from the box's measure (each extent at least
+      // 1e-3 of the largest, so a flat box does not make needle cells).
+      double measure = 1.0;
+      for (int d = 0; d < Dim; ++d) measure *= std::max(ext[d], 1e-3 * big);
+      const double s = std::pow(measure / static_cast<double>(ids.size()), 1.0 / Dim);
+      for (int d = 0; d < Dim; ++d) {
+        k_[d] = static_cast<int>(std::clamp(std::ceil(ext[d] / s), 1.0, 1e6));
+        inv_[d] = static_cast<double>(k_[d]) / std::max(ext[d], 1e-300);
+        n_cells *= static_cast<std::size_t>(k_[d]);
+      }
+    }
+    start_.assign(n_cells + 1, 0);
+    for (const std::int32_t id : ids) ++start_[cell_of(pts[id]) + 1];
+    for (std::size_t c = 0; c < n_cells; ++c) start_[c + 1] += start_[c];
+    ids_.resize(ids.size());
+    std::vector<std::int32_t> fill(start_.begin(), start_.end() - 1);
+    for (const std::int32_t id : ids) ids_[static_cast<std::size_t>(fill[cell_of(pts[id])]++)] = id;
+  }
+
+  /// Calls visit(id) for every point inside the closed box: cell by cell (the first axis
+  /// fastest), within a cell in the order of the constructor's ids.
+  template <class Visit> void query(const Box<Dim>& box, Visit&& visit) const {
+    std::array<int, Dim> lo, hi, at;
+    for (int d = 0; d < Dim; ++d) {
+      if (!(box.lo[d] <= box.hi[d])) return;  // empty (or NaN): contains nothing
+      lo[d] = coord(box.lo[d], d), hi[d] = coord(box.hi[d], d);
+    }
+    at = lo;
+    for (;;) {
+      std::size_t c = 0;
+      for (int d = Dim - 1; d >= 0; --d) c = c * static_cast<std::size_t>(k_[d]) + static_cast<std::size_t>(at[d]);
+      for (std::int32_t i = start_[c]; i < start_[c + 1]; ++i)
+        if (box.contains(pts_[ids_[static_cast<std::size_t>(i)]])) visit(ids_[static_cast<std::size_t>(i)]);
+      int d = 0;
+      while (d < Dim && at[d] == hi[d]) at[d] = lo[d], ++d;
+      if (d == Dim) return;
+      ++at[d];
+    }
+  }
+
+ private:
+  /// The cell index along axis d: monotone in x (so a box's cells hold every point inside it),
+  /// clamped to the grid (points outside the bounds, non-finite coordinates).
+  int coord(double x, int d) const {
+    const double t = (x - lo_[d]) * inv_[d];
+    if (!(t >= 0)) return 0;
+    if (t >= k_[d]) return k_[d] - 1;
+    return static_cast<int>(t);
+  }
+  std::size_t cell_of(const Point<Dim>& p) const {
+    std::size_t c = 0;
+    for (int d = Dim - 1; d >= 0; --d) c = c * static_cast<std::size_t>(k_[d]) + static_cast<std::size_t>(coord(p[d], d));
+    return c;
+  }
+
+  const std::vector<Point<Dim>>& pts_;
+  Point<Dim> lo_;
+  std::array<int, Dim> k_{};
+  std::array<double, Dim> inv_{};
+  std::vector<std::int32_t> start_, ids_;
+};
+
+}  // namespace febemesh
