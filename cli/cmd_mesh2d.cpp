@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <thread>
 
@@ -121,6 +122,17 @@ int run(const std::vector<std::string>& argv) {
   check_budget(curve, opt.level != no_level ? opt.level : curve.global_level(), opt.max_cells);
 
   Result2d r = mesh2d(curve, opt, progress);
+
+  // The folder is made before the validation, so that with two threads or more mesh.msh and
+  // mesh.vtu are written beside it and the fidelity measures (both only read the mesh; a mesh
+  // that fails validation throws below, and the folder is removed). Flange level 9 (callgrind,
+  // one thread): the two writers were 1.21 G of the CLI's 6.18 G instructions.
+  progress("writing " + out);
+  AtomicOutputDir dir(out);
+  std::future<void> writing = std::async(opt.n_threads > 1 ? std::launch::async : std::launch::deferred, [&] {
+    write_msh<2>(r.fe.mesh, dir.file("mesh.msh"), encoding);
+    write_vtu<2>(r.fe.mesh, dir.file("mesh.vtu"));
+  });
   const Fidelity2d fid = measure_fidelity(r.fe, curve);
 
   ValidationReport valid;
@@ -132,14 +144,10 @@ int run(const std::vector<std::string>& argv) {
     vo.boundary_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
     vo.boundary_tolerance = 1e-10 * (bb.hi - bb.lo).norm();
     valid = validate<2>(r.fe.mesh, vo);
-    if (!valid.valid)
-      throw std::runtime_error("the mesh of " + input + " failed validation (please report):\n" + valid.summary());
   }
-
-  progress("writing " + out);
-  AtomicOutputDir dir(out);
-  write_msh<2>(r.fe.mesh, dir.file("mesh.msh"), encoding);
-  write_vtu<2>(r.fe.mesh, dir.file("mesh.vtu"));
+  if (!valid.valid && !args.has("--no-validate"))
+    throw std::runtime_error("the mesh of " + input + " failed validation (please report):\n" + valid.summary());
+  writing.get();  // rethrows a write error (one thread: writes now)
   if (r.stages_kept) write_stage_figures(r, curve, dir.file("figures"));
   else if (opt.keep_stages) write_figures_skipped_note(dir.file("figures"), r.fe.mesh.solid.size(), opt.keep_stages_max_elements);
   if (opt.keep_stages) draw_geometry_figure(curve, dir.file("figures") / "00-geometry.svg");

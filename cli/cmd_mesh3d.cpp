@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <future>
 #include <iostream>
 #include <sstream>
 #include <thread>
@@ -125,6 +126,15 @@ int run(const std::vector<std::string>& argv) {
   }
   const Mesh<3>& mesh = r.fe.mesh;
 
+  // The folder is made before the validation, so that with two threads or more mesh.msh and
+  // mesh.vtu are written beside it and the measures (the writers only read the mesh; a mesh that
+  // fails validation throws below, and the folder is removed). sphere966 level 4 (callgrind,
+  // one thread): the writers were 168 M of the CLI's 2.34 G instructions, the checks 435 M.
+  AtomicOutputDir dir{std::filesystem::path(*out)};
+  std::future<void> writing = std::async(opt.n_threads > 1 ? std::launch::async : std::launch::deferred, [&] {
+    write_msh(mesh, dir.file("mesh.msh"));
+    write_vtu(mesh, dir.file("mesh.vtu"));
+  });
   progress("validating " + std::to_string(mesh.solid.size()) + " tetrahedra");
   const auto tv = std::chrono::steady_clock::now();
   const ValidateOptions<3> vo = dim3::surface_validation(surface);
@@ -135,6 +145,7 @@ int run(const std::vector<std::string>& argv) {
 
   if (!vr.valid && !args.has("--allow-invalid"))
     throw GeometryError(input + ": the mesh is not valid:\n" + vr.summary());
+  writing.get();  // rethrows a write error (one thread: writes now)
 
   nlohmann::json rep;
   rep["input"] = input;
@@ -237,9 +248,6 @@ int run(const std::vector<std::string>& argv) {
   }
   rep["warnings"] = warnings;
 
-  AtomicOutputDir dir{std::filesystem::path(*out)};
-  write_msh(mesh, dir.file("mesh.msh"));
-  write_vtu(mesh, dir.file("mesh.vtu"));
   {
     std::ofstream os(dir.file("report.json"));
     os << rep.dump(2) << "\n";
