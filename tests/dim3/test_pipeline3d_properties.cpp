@@ -365,5 +365,8 @@ TEST_CASE("shrunk 3D property counterexamples mesh validly", "[pipeline3d][regre
 }
 
 TEST_CASE("shrunk 3D property counterexamples not fixed yet", "[pipeline3d][regression][!mayfail]") {
+  // Not under the sanitizers: these are refused through every try (17 CPU s in Release, several
+  // minutes under ASan) and cannot fail the run; the refusal paths run in other tests.
+  if (test::sanitized()) return;
   for (const fs::path& f : regression_files(true)) check_regression(f);
 }
