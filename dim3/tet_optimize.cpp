@@ -96,6 +96,9 @@ struct MovingTet {
   }
 };
 
+constexpr int max_tangent_planes = 3;
+constexpr int max_tangent_candidates = max_tangent_planes * 3 * 2;
+
 struct Optimizer {
   Mesh<3>& mesh;
   std::vector<BoundaryLocation>& where;
@@ -110,6 +113,7 @@ struct Optimizer {
   /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
   std::vector<double> tet_q;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
+  double tangent_rank = 0.0;  ///< angle_rank of opt.tangent_below_deg
   /// One thread's working space for relax.
   struct alignas(64) Scratch {
     std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
@@ -321,6 +325,47 @@ struct Optimizer {
     return start[v + 1] > start[v];
   }
 
+  /// Surface-node candidates that stay in the tangent planes of the surface around v (its own
+  /// and its interface neighbours' normals): the search directions and the way to the centroid
+  /// of its interface neighbours, each projected into those planes. The other candidates leave
+  /// the surface and are brought back by the closest point, which outside a convex feature edge
+  /// is the edge itself: nodes crowded onto a feature line by their projections could never
+  /// leave it, and the interface triangles they make there are caps (measured: spool L4's 2.6
+  /// deg and anchor L4's 8.3 deg tetrahedra all stand on such caps, 177-179 deg).
+  int tangent_candidates(std::int32_t v, const P3& x0, double len, const P3* dirs, int n_dirs, P3* out) const {
+    std::array<P3, max_tangent_planes> planes;
+    int n_planes = 0;
+    // Planes 30 deg or more apart: only across a crease (a feature line's two sides).
+    const auto add_plane = [&](const P3& n) {
+      const double l = n.norm();
+      if (!(l > 0) || n_planes == max_tangent_planes) return;
+      const P3 u = n / l;
+      for (int i = 0; i < n_planes; ++i)
+        if (planes[i].dot(u) > std::cos(pi / 6)) return;
+      planes[n_planes++] = u;
+    };
+    add_plane(node_normal[v]);
+    P3 ring = P3::Zero();
+    int n_ring = 0;
+    for (std::int32_t k = f_start[v]; k < f_start[v + 1]; ++k)
+      for (const std::int32_t u : faces[f_incident[k]])
+        if (u != v) add_plane(node_normal[u]), ring += mesh.points[u], ++n_ring;
+    if (n_planes < 2) return 0;  // smooth surface around v: the projected candidates do
+    std::array<P3, 3> moves;
+    int n_moves = 0;
+    for (int i = 0; i < n_dirs; ++i) moves[n_moves++] = dirs[i];
+    if (n_ring > 0 && (ring / n_ring - x0).norm() > 0) moves[n_moves++] = (ring / n_ring - x0).normalized();
+    int n = 0;
+    for (int p = 0; p < n_planes; ++p)
+      for (int i = 0; i < n_moves; ++i) {
+        P3 t = moves[i] - moves[i].dot(planes[p]) * planes[p];
+        if (!(t.norm() > 0.1)) continue;
+        t.normalize();
+        for (double s : {0.2, 0.05}) out[n++] = x0 + s * len * t;
+      }
+    return n;
+  }
+
   /// One local search at node v; returns true if it moved. Reads v's neighbours and the
   /// ranks of v's tetrahedra, writes v (point, location, normal) and those ranks.
   bool relax(std::int32_t v, Scratch& sc) {
@@ -363,7 +408,7 @@ struct Optimizer {
     }
     if (sum.norm() > 0) dirs[n_dirs++] = sum.normalized();
 
-    std::array<P3, 10> cands;
+    std::array<P3, 10 + max_tangent_candidates> cands;
     int n_cands = 0;
     P3 centroid = P3::Zero();
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) centroid += mesh.points[nbs[k]];
@@ -372,6 +417,8 @@ struct Optimizer {
     cands[n_cands++] = 0.5 * (centroid + x0);
     for (int i = 0; i < n_dirs; ++i)
       for (double s : {0.25, 0.08, 0.025, 0.006}) cands[n_cands++] = x0 + s * len * dirs[i];
+    if (guard && !opt.untangle_only && f0 < tangent_rank)
+      n_cands += tangent_candidates(v, x0, len, dirs.data(), n_dirs, &cands[n_cands]);
 
     double best = f0;
     P3 best_x = x0;
@@ -455,7 +502,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -512,6 +559,7 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   std::vector<std::uint8_t> active(n, 0);
   o.tet_q.resize(o.tets.size());
   o.target_rank = angle_rank(target);
+  o.tangent_rank = angle_rank(opt.tangent_below_deg * pi / 180.0);
   bool any_active = false;
   for (std::size_t i = 0; i < o.tets.size(); ++i) {
     const Tet& t = o.tets[i];

@@ -12,6 +12,8 @@
 //   long      - a projection longer than 1.5 face sizes;
 //   other     - all projections go out and land facing the face: shear between neighbours.
 // Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]
+// --pipeline runs the whole pipeline instead; with --quality it sorts the final mesh's tetrahedra
+// under 10 degrees by where they come from (print_quality_diagnosis).
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
 // retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
 
@@ -19,6 +21,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <algorithm>
+#include <array>
 #include <map>
 #include <set>
 #include <string>
@@ -33,9 +37,99 @@
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_boundary.hpp"
 #include "dim3/templates3d.hpp"
+#include "dim3/tet_optimize.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
+
+namespace {
+
+/// The six dihedral angles (degrees) of a tetrahedron, at edges 01 02 03 12 13 23.
+std::array<double, 6> tet_dihedral_angles_deg(const P3& a, const P3& b, const P3& c, const P3& d) {
+  const P3 p[4] = {a, b, c, d};
+  static const int edge_nodes[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  std::array<double, 6> out{};
+  for (int k = 0; k < 6; ++k) {
+    const int i = edge_nodes[k][0], j = edge_nodes[k][1];
+    int o[2], n = 0;
+    for (int l = 0; l < 4; ++l)
+      if (l != i && l != j) o[n++] = l;
+    const P3 e = (p[j] - p[i]).normalized();
+    P3 u = p[o[0]] - p[i], w = p[o[1]] - p[i];
+    u -= u.dot(e) * e;
+    w -= w.dot(e) * e;
+    const double nn = u.norm() * w.norm();
+    out[k] = nn > 0 ? std::acos(std::clamp(u.dot(w) / nn, -1.0, 1.0)) * 180.0 / 3.14159265358979 : 0.0;
+  }
+  return out;
+}
+
+
+/// Why are the 3D meshes' smallest dihedral angles small? (issue 6) For the final mesh of the
+/// pipeline: how many tetrahedra fall under 5/10/15 degrees, which cells they come from
+/// (interior octants or boundary octants), what their nodes are (interior, smooth surface,
+/// feature line, corner) and whether their worst edge is an edge of the surface mesh.
+void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int dump) {
+  const Mesh<3>& m = r.fe.mesh;
+  const std::vector<BoundaryLocation>& where = r.fe.where;
+  std::size_t n_interior_cells = 0;
+  for (auto f : r.interior) n_interior_cells += f ? 1 : 0;
+  const auto kind = [&](std::int32_t v) {
+    if (static_cast<std::size_t>(v) >= where.size() || where[v].patch < 0) return 0;  // interior
+    return 1 + static_cast<int>(where[v].kind);  // 1 smooth, 2 feature line, 3 corner
+  };
+  std::set<std::pair<std::int32_t, std::int32_t>> surface_edges;
+  for (std::size_t f = 0; f < m.interface.size(); ++f) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t a = v[k].v, b = v[(k + 1) % 3].v;
+      surface_edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  }
+  double min_feature_deg = 180.0;  // the surface's sharpest edge: a bound for tets with two faces on it
+  for (std::int32_t e : s.features().feature_edges())
+    min_feature_deg = std::min(min_feature_deg, 180.0 - s.features().dihedral(e) * 180.0 / 3.14159265358979);
+  const double bars[] = {2, 5, 10, 15};
+  std::size_t n_under[4] = {0, 0, 0, 0};
+  std::map<std::string, std::size_t> by_kind;
+  struct Bad { double deg; std::size_t e; };
+  std::vector<Bad> worst;
+  static const int edge_nodes[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const P3 p[4] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]};
+    const std::array<double, 6> ang = tet_dihedral_angles_deg(p[0], p[1], p[2], p[3]);
+    const int worst_edge = static_cast<int>(std::min_element(ang.begin(), ang.end()) - ang.begin());
+    const double deg = ang[worst_edge];
+    for (int b = 0; b < 4; ++b) n_under[b] += deg < bars[b] ? 1 : 0;
+    if (deg >= 10) continue;
+    worst.push_back({deg, e});
+    int nk[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 4; ++k) ++nk[kind(v[k].v)];
+    const std::int32_t a = v[edge_nodes[worst_edge][0]].v, b = v[edge_nodes[worst_edge][1]].v;
+    const bool on_surface = surface_edges.count({std::min(a, b), std::max(a, b)}) > 0;
+    const bool boundary_cell = r.fe.cell[e] >= static_cast<std::int32_t>(n_interior_cells);
+    char key[160];
+    std::snprintf(key, sizeof key, "%s cell, nodes int/smooth/feature/corner %d/%d/%d/%d, worst edge %s",
+                  boundary_cell ? "boundary" : "interior", nk[0], nk[1], nk[2], nk[3],
+                  on_surface ? "on the surface" : "inside");
+    ++by_kind[key];
+  }
+  std::printf("QUALITY %zu tets: under 2/5/10/15 deg: %zu/%zu/%zu/%zu; sharpest feature edge %.1f deg\n", m.solid.size(),
+              n_under[0], n_under[1], n_under[2], n_under[3], min_feature_deg);
+  for (const auto& [k, n] : by_kind) std::printf("  %6zu  %s\n", n, k.c_str());
+  std::sort(worst.begin(), worst.end(), [](const Bad& x, const Bad& y) { return x.deg < y.deg; });
+  for (std::size_t i = 0; i < worst.size() && static_cast<int>(i) < dump; ++i) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(worst[i].e)});
+    std::printf("  tet %zu %.2f deg:", worst[i].e, worst[i].deg);
+    for (int k = 0; k < 4; ++k)
+      std::printf(" %d(%d %.4f %.4f %.4f)", v[k].v, kind(v[k].v), m.points[v[k].v][0], m.points[v[k].v][1],
+                  m.points[v[k].v][2]);
+    std::printf("\n");
+  }
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
@@ -88,7 +182,12 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--topology-refinements") opt.topology_refinements = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--extra-levels") opt.extra_levels = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--thickness-extra") opt.thickness_extra_levels = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--optimize-sweeps") opt.optimize_sweeps = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--target-dihedral") opt.target_dihedral_deg = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--smooth") opt.smoothing_iterations = std::atoi(argv[i + 1]);
   }
+  bool quality = false;
+  for (int i = 1; i < argc; ++i) quality = quality || std::string(argv[i]) == "--quality";
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--pipeline") {
       const auto t0 = std::chrono::steady_clock::now();
@@ -104,6 +203,7 @@ int main(int argc, char** argv) {
         min_dihedral = summarize_quality(r.fe.mesh).min_angle_deg;
         vol_err = measure_fidelity(r.fe.mesh, s, 1).volume_rel_error;
         repairs = r.n_repairs;
+        if (quality) print_quality_diagnosis(r, s, dump);
       } catch (const std::exception& e) {
         verdict = std::string("refused: ") + e.what();
         if (verdict.size() > 300) verdict.resize(300);
@@ -131,8 +231,9 @@ int main(int argc, char** argv) {
               path.c_str(), level, so.thickness_cells, tree.n_leaves(), n_in, nb, np, ni);
   const OctantComplexResult ocr = build_octant_complex(tree, in, s, bo);
   const OctantComplex& oc = ocr.complex;
-  std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu\n", ocr.stats.n_free_faces,
-              ocr.stats.n_surface_nodes, ocr.stats.n_next_normal, ocr.stats.n_ray, ocr.stats.n_blind);
+  std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu, edge-snapped %zu, pushed off lines %zu\n",
+              ocr.stats.n_free_faces, ocr.stats.n_surface_nodes, ocr.stats.n_next_normal, ocr.stats.n_ray,
+              ocr.stats.n_blind, ocr.stats.n_edge_snapped, ocr.stats.n_pushed_off_lines);
   const SurfacePointFn sp = [&](const P3& p) {
     const ClosestPoint<3> cp = s.closest_point(p);
     return std::make_pair(P3(cp.point), cp.where);

@@ -37,6 +37,15 @@
 // 28.17/27.67 deg, spool L4 9.66 deg, anchor L4 276042 tets 8.29 deg 0.59%, fandisk L4 180486
 // tets 11.50 deg 2.03% (4 repairs), elephant L4 1168938 tets 1.10 deg 0.31%, 148 s CPU; the
 // [data] run 155-161 s wall.
+// Issue 6, quality (session q3, CLI --threads 1): the tetrahedra under 10 deg all stood in
+// boundary octants on interface caps at feature lines (experiments/diagnose3d --pipeline
+// --quality); feature snapping now pushes the nodes it leaves on crowded concave lines into a face
+// (BoundaryOctantOptions::off_line) and the optimiser moves bad nodes at creases along the faces
+// (TetOptimizeOptions::tangent_below_deg): sphere966 L4/L5 byte-identical (28.17/27.67 deg),
+// spool L4 2.59 -> 10.24 deg (163244 tets, 3.17% volume error, 6.5 s CPU), anchor L4 8.29 ->
+// 8.73 (276042 tets, 0.58%, 20 s), fandisk L4 11.50 -> 12.21 (180486 tets, 2.03%, 20 s),
+// elephant L4 1.10 -> 1.63 (1168754 tets, 0.31%, 154 s). Left under 10 deg: anchor's quad
+// bridging a convex feature edge, elephant's tetrahedra at fixed corners.
 // The sanitizer build runs sphere966 L4 and spool L4 only: the cases tagged [slow] are left out
 // by its ctest command (tests/CMakeLists.txt).
 
@@ -104,11 +113,13 @@ TEST_CASE("mesh3d data: spool level 4 (its thin flanges kept by the thickness re
   // The first mesh is valid but loses 17.1% of the volume in the flanges thinner than 1.5
   // level-4 octants; the retry with two octants across every part (thickness level, up to level
   // 6) and without the buffer rule is valid at its first tree (CLI --threads 1: 163244 tets, min
-  // dihedral 2.59 deg, volume error 3.22%).
+  // dihedral 2.59 deg, volume error 3.22%). Its 4 tetrahedra under 10 deg stood on interface
+  // caps at a concave feature line; with the nodes pushed off it and the optimiser's moves along
+  // creases: 10.24 deg, 3.17% (issue 6 asks for 10 deg).
   const DataRun d = mesh_and_validate("spool", 4);
   CHECK(d.thickness_refined);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 2.0);
+  CHECK(d.min_dihedral_deg >= 10.0);
   CHECK(d.volume_rel_error < 0.05);
 }
 
@@ -117,9 +128,10 @@ TEST_CASE("mesh3d data: fandisk level 4 (valid with facing projections only)", "
   // octants); the last one, projections leaving through every free face and landing on surface
   // facing it, is valid after 4 repairs with the dihedral optimiser of session 7 (CLI: 180486
   // tets, 11.50 deg, 2.03%; 3 repairs and 131238 tets before it): the CLI's repair budget.
+  // Issue 6 (the optimiser's moves along creases): 12.21 deg.
   const DataRun d = mesh_and_validate("fandisk", 4, Options3d{}.max_repairs);
   CHECK(d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 10.0);
+  CHECK(d.min_dihedral_deg >= 12.0);
   CHECK(d.volume_rel_error < 0.03);
 }
 
@@ -134,11 +146,13 @@ TEST_CASE("mesh3d data: rotor level 4 (known to fail: valid, but 34.5% of the vo
 
 TEST_CASE("mesh3d data: anchor level 4 (valid without the buffer rule)", "[data][pipeline3d][slow]") {
   // With the buffer rule the one-octant slabs in its two-octant-thick arms fold their boundary
-  // octants (rim nodes project through the arm); the run without the buffer is valid.
+  // octants (rim nodes project through the arm); the run without the buffer is valid. Issue 6:
+  // 8.29 -> 8.73 deg (one of its two places under 10 deg was an interface cap at a concave
+  // feature line).
   const DataRun d = mesh_and_validate("anchor", 4);
   CHECK(d.buffer_dropped);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 5.0);
+  CHECK(d.min_dihedral_deg >= 8.5);
   CHECK(d.volume_rel_error < 0.02);
 }
 
@@ -150,9 +164,10 @@ TEST_CASE("mesh3d data: elephant level 4 (valid after refining around its island
   // at the maximum level; a repair that makes it worse); the run without it is valid after 5
   // repairs, one of them the refinement of the octants on the surface for a lost handle (Euler
   // characteristic -1, expected -2). Here that run directly (buffer 0), which is what mesh3d
-  // reaches: measured 1172552 tets, min dihedral 1.10 deg, volume error 0.32%.
+  // reaches: measured 1172552 tets, min dihedral 1.10 deg, volume error 0.32%; issue 6 (CLI):
+  // 1.63 deg, its worst tetrahedra now at fixed feature corners.
   const DataRun d = mesh_and_validate("elephant", 4, 6, false, 0.0);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 1.0);
+  CHECK(d.min_dihedral_deg >= 1.5);
   CHECK(d.volume_rel_error < 0.01);
 }
