@@ -564,7 +564,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         return restore_saved();
       }
       throw LimitError("the boundary octants could not be built within the work bound: " + why + ", after " +
-                       std::to_string(r.n_repairs) + " repair(s); try another --level");
+                       std::to_string(r.n_repairs) + " repair(s); try another --level, or a larger --effort");
     }
     say("boundary octants: projecting the free faces onto the surface");
     BoundaryOctantOptions bo;
