@@ -433,7 +433,6 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   // the k-d tree is built only to report an edge with several hanging nodes in its order.
   std::optional<PointTree<Dim>> tree;
   const PointGrid<Dim> grid(pts, used_ids);
-  auto query = [&](const Box<Dim>& box, auto&& visit) { grid.query(box, visit); };
 
   // Duplicate nodes (the smallest id within tol: the same whatever the order of the visits).
   {
@@ -442,7 +441,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     const double tol = used_ids.empty() ? 0.0 : options.duplicate_rel_tol * all.extent().norm();
     for (const auto i : used_ids) {
       std::int32_t first = i;
-      query(inflated_box<Dim>({pts[i]}, tol), [&](std::int32_t j) {
+      grid.query(inflated_box<Dim>({pts[i]}, tol), [&](std::int32_t j) {
         if (j < first && (pts[j] - pts[i]).norm() <= tol) first = j;
       });
       if (first == i) continue;
@@ -474,7 +473,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       auto on_edge = [&](std::int32_t c) { return c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pa, pb, rel); };
       auto report_edge = [&](std::int32_t c) { report(c, "edge " + std::to_string(a.v) + "-" + std::to_string(b.v)); };
       hits.clear();
-      query(box, [&](std::int32_t c) {
+      grid.query(box, [&](std::int32_t c) {
         if (on_edge(c)) hits.push_back(c);
       });
       if (hits.size() == 1) {
@@ -498,7 +497,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         }
         box.lo.array() -= rel * h;
         box.hi.array() += rel * h;
-        query(box, [&](std::int32_t c) {
+        grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
           if (on_facet_interior(pts[c], f, pts, rel)) report(c, "facet " + fmt_key(uses[i].key));
