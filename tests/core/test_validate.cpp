@@ -225,31 +225,14 @@ TEST_CASE("validation of a large grid is fast enough", "[validate]") {
 
 namespace {
 
-/// The Kuhn tetrahedra (six per cell) of an n^3 grid of unit cells, those whose index `keep`
-/// accepts; ids of the (n+1)^3 grid nodes, unused ones included.
+/// The Kuhn tetrahedra (six per cell, test::grid_mesh) of an n^3 grid of unit cells, those whose
+/// index `keep` accepts; ids of the (n+1)^3 grid nodes, unused ones included.
 template <class Keep> Mesh<3> kuhn_cube(int n, Keep&& keep) {
+  const Mesh<3> grid = test::grid_mesh<3>(n, true);
   Mesh<3> m;
-  const int p = n + 1;
-  auto id = [&](int i, int j, int k) { return (k * p + j) * p + i; };
-  for (int k = 0; k < p; ++k)
-    for (int j = 0; j < p; ++j)
-      for (int i = 0; i < p; ++i) m.points.push_back(Point<3>(i, j, k));
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  std::size_t index = 0;
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& perm : perms) {
-          if (!keep(index++)) continue;
-          int c[3] = {i, j, k};
-          std::array<VertexId, 4> t;
-          t[0] = VertexId{id(c[0], c[1], c[2])};
-          for (int s = 0; s < 3; ++s) {
-            ++c[perm[s]];
-            t[s + 1] = VertexId{id(c[0], c[1], c[2])};
-          }
-          m.solid.add(ElemType::Tet4, t.data(), 4);
-        }
+  m.points = grid.points;
+  for (std::size_t e = 0; e < grid.solid.size(); ++e)
+    if (keep(e)) m.solid.add(ElemType::Tet4, grid.solid.nodes(ElemId{static_cast<std::int32_t>(e)}), 4);
   return m;
 }
 

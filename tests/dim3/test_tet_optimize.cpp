@@ -11,6 +11,7 @@
 #include "core/mesh.hpp"
 #include "dim3/tet_optimize.hpp"
 #include "property.hpp"
+#include "core/test_mesh_fixtures.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -27,40 +28,26 @@ rc::Gen<P3> gen_point() {
                       });
 }
 
-/// A jittered cube of n^3 nodes cut into six tetrahedra per cell (Kuhn), all positive.
+/// A jittered cube of n^3 nodes cut into six tetrahedra per cell (Kuhn, test::grid_mesh), all
+/// positive: the inner nodes moved by up to jitter/2 along each axis, then every tetrahedron the
+/// jitter turned over reoriented.
 Mesh<3> jittered_cube(double jitter, unsigned seed, int n = 5) {
-  Mesh<3> m;
-  auto id = [&](int i, int j, int k) { return (k * n + j) * n + i; };
+  Mesh<3> m = test::grid_mesh<3>(n - 1, true);
+  m.interface.clear();
+  m.level.clear();
+  m.from_boundary_cell.clear();
   std::uint64_t s = seed;
   auto rnd = [&] {
     s = s * 6364136223846793005ULL + 1442695040888963407ULL;
     return double(s >> 11) / double(1ULL << 53) - 0.5;
   };
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i) {
-        const bool inner = i > 0 && j > 0 && k > 0 && i < n - 1 && j < n - 1 && k < n - 1;
-        P3 p(i, j, k);
-        if (inner) p += jitter * P3(rnd(), rnd(), rnd());
-        m.points.push_back(p);
-      }
-  // Kuhn: the six paths 0 -> 7 along the cube's edges.
-  const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int k = 0; k + 1 < n; ++k)
-    for (int j = 0; j + 1 < n; ++j)
-      for (int i = 0; i + 1 < n; ++i)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          std::array<VertexId, 4> t;
-          t[0] = VertexId{id(c[0], c[1], c[2])};
-          for (int s2 = 0; s2 < 3; ++s2) {
-            ++c[p[s2]];
-            t[s2 + 1] = VertexId{id(c[0], c[1], c[2])};
-          }
-          const P3 &a = m.points[t[0].v], &b = m.points[t[1].v], &cc = m.points[t[2].v], &d = m.points[t[3].v];
-          if ((b - a).dot((cc - a).cross(d - a)) < 0) std::swap(t[2], t[3]);
-          m.solid.add(ElemType::Tet4, t.data(), 4);
-        }
+  for (P3& p : m.points)
+    if (p.minCoeff() > 0 && p.maxCoeff() < n - 1) p += jitter * P3(rnd(), rnd(), rnd());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    VertexId* t = m.solid.node.data() + m.solid.offset[e];
+    const P3 &a = m.points[t[0].v], &b = m.points[t[1].v], &c = m.points[t[2].v], &d = m.points[t[3].v];
+    if ((b - a).dot((c - a).cross(d - a)) < 0) std::swap(t[2], t[3]);
+  }
   return m;
 }
 
