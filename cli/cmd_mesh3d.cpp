@@ -144,7 +144,7 @@ int run(const std::vector<std::string>& argv) {
   });
   const ValidateOptions<3> vo = dim3::surface_validation(surface);
   const ValidationReport vr = validate(mesh, vo);
-  const QualitySummary q = summarize_quality(mesh);
+  const QualitySummary q = summarize_quality(mesh, 10.0, opt.n_threads);
   const dim3::Fidelity3d fid = measuring.get();
   const double t_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - tv).count();
 

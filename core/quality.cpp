@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/mesh_topology.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh {
 
@@ -332,29 +333,57 @@ template <int Dim> std::vector<double> scaled_jacobians(const Elements& els, con
   return out;
 }
 
-template <int Dim> QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg) {
+template <int Dim>
+QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg, int n_threads) {
   QualitySummary s;
   s.sliver_threshold_deg = sliver_threshold_deg;
   s.n_elements = mesh.solid.size();
   if (s.n_elements == 0) return s;
+  // Partial summaries of fixed chunks, combined in chunk order: the sums (mean scaled Jacobian,
+  // measure) round the same way for every thread count.
+  constexpr std::size_t chunk = 1 << 14;
+  struct Part {
+    QualitySummary s;
+    double sum_sj = 0.0;
+  };
+  std::vector<Part> parts((s.n_elements + chunk - 1) / chunk);
+  for_each_chunk(s.n_elements, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    QualitySummary& p = parts[c].s;
+    p.min_scaled_jacobian = inf;
+    p.min_angle_deg = inf;
+    p.max_angle_deg = -inf;
+    for (std::size_t e = begin; e < end; ++e) {
+      const ElemType t = mesh.solid.type[e];
+      const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+      const ElementQuality q = element_quality<Dim>(t, ep.span());
+      p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, q.scaled_jacobian);
+      parts[c].sum_sj += q.scaled_jacobian;
+      p.min_angle_deg = std::min(p.min_angle_deg, q.min_angle_deg);
+      p.max_angle_deg = std::max(p.max_angle_deg, q.max_angle_deg);
+      p.max_aspect_ratio = std::max(p.max_aspect_ratio, q.aspect_ratio);
+      p.max_radius_ratio = std::max(p.max_radius_ratio, q.radius_ratio);
+      const int bin = std::clamp(static_cast<int>(std::floor((q.scaled_jacobian + 1.0) / 0.2)), 0, 9);
+      ++p.scaled_jacobian_histogram[bin];
+      if (q.min_angle_deg < sliver_threshold_deg) ++p.n_slivers;
+      p.measure += signed_measure<Dim>(t, ep.span());
+    }
+  });
   s.min_scaled_jacobian = inf;
   s.min_angle_deg = inf;
   s.max_angle_deg = -inf;
   double sum_sj = 0.0;
-  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
-    const ElemType t = mesh.solid.type[e];
-    const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
-    const ElementQuality q = element_quality<Dim>(t, ep.span());
-    s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, q.scaled_jacobian);
-    sum_sj += q.scaled_jacobian;
-    s.min_angle_deg = std::min(s.min_angle_deg, q.min_angle_deg);
-    s.max_angle_deg = std::max(s.max_angle_deg, q.max_angle_deg);
-    s.max_aspect_ratio = std::max(s.max_aspect_ratio, q.aspect_ratio);
-    s.max_radius_ratio = std::max(s.max_radius_ratio, q.radius_ratio);
-    const int bin = std::clamp(static_cast<int>(std::floor((q.scaled_jacobian + 1.0) / 0.2)), 0, 9);
-    ++s.scaled_jacobian_histogram[bin];
-    if (q.min_angle_deg < sliver_threshold_deg) ++s.n_slivers;
-    s.measure += signed_measure<Dim>(t, ep.span());
+  for (const Part& part : parts) {
+    const QualitySummary& p = part.s;
+    s.min_scaled_jacobian = std::min(s.min_scaled_jacobian, p.min_scaled_jacobian);
+    sum_sj += part.sum_sj;
+    s.min_angle_deg = std::min(s.min_angle_deg, p.min_angle_deg);
+    s.max_angle_deg = std::max(s.max_angle_deg, p.max_angle_deg);
+    s.max_aspect_ratio = std::max(s.max_aspect_ratio, p.max_aspect_ratio);
+    s.max_radius_ratio = std::max(s.max_radius_ratio, p.max_radius_ratio);
+    for (std::size_t b = 0; b < s.scaled_jacobian_histogram.size(); ++b)
+      s.scaled_jacobian_histogram[b] += p.scaled_jacobian_histogram[b];
+    s.n_slivers += p.n_slivers;
+    s.measure += p.measure;
   }
   s.mean_scaled_jacobian = sum_sj / static_cast<double>(s.n_elements);
   return s;
@@ -405,7 +434,7 @@ template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh) {
   template ElementQuality element_quality<D>(ElemType, std::span<const Point<D>>);                 \
   template ElemPoints<D> element_points<D>(const Elements&, ElemId, const std::vector<Point<D>>&); \
   template std::vector<double> scaled_jacobians<D>(const Elements&, const std::vector<Point<D>>&); \
-  template QualitySummary summarize_quality<D>(const Mesh<D>&, double);                            \
+  template QualitySummary summarize_quality<D>(const Mesh<D>&, double, int);                       \
   template double solid_measure<D>(const Mesh<D>&);                                                \
   template double interface_enclosed_measure<D>(const Mesh<D>&);
 FEBEMESH_INSTANTIATE(2)

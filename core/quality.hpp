@@ -62,8 +62,10 @@ struct QualitySummary {
   double measure = 0.0;       ///< area (2D) / volume (3D) of the solid
 };
 
-/// Summary over the solid elements. Sliver threshold: 10 degrees by default.
-template <int Dim> QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg = 10.0);
+/// Summary over the solid elements. Sliver threshold: 10 degrees by default. On n_threads
+/// threads, with the same result (bit for bit) for every thread count.
+template <int Dim>
+QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg = 10.0, int n_threads = 1);
 
 /// Area (2D) / volume (3D) of the solid elements, signed.
 template <int Dim> double solid_measure(const Mesh<Dim>& mesh);

@@ -121,3 +121,40 @@ TEST_CASE("slivers are counted below the dihedral threshold", "[quality]") {
   CHECK(summarize_quality(m, 10.0).n_slivers == 1);
   CHECK(summarize_quality(m, 0.1).n_slivers == 0);
 }
+
+TEST_CASE("the summary is the same on 1, 2 and 3 threads and sums what its elements give", "[quality][threads]") {
+  // 16^3 cells, six tets each: 24576 tets, two of the summary's fixed chunks. Nodes moved off the
+  // grid so that the scaled Jacobians and volumes differ from element to element.
+  Mesh<3> m = test::grid_mesh<3>(16, true);
+  for (Point<3>& p : m.points) p += 0.2 * Point<3>(std::sin(7.0 * p.y()), std::cos(5.0 * p.z()), std::sin(3.0 * p.x()));
+  const QualitySummary one = summarize_quality(m, 40.0, 1);
+  for (const int threads : {2, 3}) {
+    const QualitySummary s = summarize_quality(m, 40.0, threads);
+    CAPTURE(threads);
+    CHECK(s.mean_scaled_jacobian == one.mean_scaled_jacobian);  // bit for bit
+    CHECK(s.measure == one.measure);
+    CHECK(s.min_scaled_jacobian == one.min_scaled_jacobian);
+    CHECK(s.min_angle_deg == one.min_angle_deg);
+    CHECK(s.max_angle_deg == one.max_angle_deg);
+    CHECK(s.max_aspect_ratio == one.max_aspect_ratio);
+    CHECK(s.max_radius_ratio == one.max_radius_ratio);
+    CHECK(s.scaled_jacobian_histogram == one.scaled_jacobian_histogram);
+    CHECK(s.n_slivers == one.n_slivers);
+  }
+  // Against the elements one by one.
+  const std::vector<double> sj = scaled_jacobians<3>(m.solid, m.points);
+  double sum = 0.0, lo = 2.0;
+  std::size_t slivers = 0;
+  for (std::size_t e = 0; e < sj.size(); ++e) {
+    sum += sj[e], lo = std::min(lo, sj[e]);
+    const auto ep = element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, m.points);
+    slivers += element_quality<3>(ElemType::Tet4, ep.span()).min_angle_deg < 40.0 ? 1 : 0;
+  }
+  CHECK(one.n_elements == sj.size());
+  CHECK(one.mean_scaled_jacobian == Approx(sum / static_cast<double>(sj.size())).epsilon(1e-12));
+  CHECK(one.min_scaled_jacobian == lo);
+  CHECK(one.measure == Approx(solid_measure<3>(m)).epsilon(1e-12));
+  CHECK(one.n_slivers == slivers);
+  CHECK(slivers > 0);
+  CHECK(slivers < sj.size());
+}

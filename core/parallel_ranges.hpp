@@ -1,0 +1,55 @@
+#pragma once
+// Independent work over [0, n) on several threads (issue 8): the caller and n_threads - 1 more
+// threads each take one contiguous range and write only their own slots, so the result does
+// not depend on the thread count. A reduction whose rounding depends on the order (a sum of
+// doubles) goes through fixed chunks (for_each_chunk) whose partial results the caller combines
+// in chunk order: the same numbers for every thread count.
+
+#include <algorithm>
+#include <cstddef>
+#include <exception>
+#include <thread>
+#include <vector>
+
+namespace febemesh {
+
+/// Calls f(begin, end) on n_threads contiguous ranges covering [0, n) (one range when n is small
+/// or n_threads is 1), the first on the calling thread; rethrows the first range's exception
+/// once all have stopped.
+template <class F> void for_each_range(std::size_t n, int n_threads, const F& f) {
+  const std::size_t n_workers = std::size_t(std::clamp(n_threads, 1, 256));
+  if (n_workers == 1 || n < 2 * n_workers) {
+    f(std::size_t{0}, n);
+    return;
+  }
+  std::vector<std::exception_ptr> errors(n_workers);
+  std::vector<std::thread> threads;
+  for (std::size_t w = 1; w < n_workers; ++w) {
+    threads.emplace_back([&, w] {
+      try {
+        f(n * w / n_workers, n * (w + 1) / n_workers);
+      } catch (...) {
+        errors[w] = std::current_exception();
+      }
+    });
+  }
+  try {
+    f(std::size_t{0}, n / n_workers);
+  } catch (...) {
+    errors[0] = std::current_exception();
+  }
+  for (auto& th : threads) th.join();
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+/// The chunks [c * chunk, min(n, (c + 1) * chunk)) of [0, n): f(c, begin, end) for every chunk c,
+/// spread over n_threads by for_each_range. The chunks do not depend on n_threads.
+template <class F> void for_each_chunk(std::size_t n, std::size_t chunk, int n_threads, const F& f) {
+  const std::size_t n_chunks = (n + chunk - 1) / chunk;
+  for_each_range(n_chunks, n_threads, [&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c) f(c, c * chunk, std::min(n, (c + 1) * chunk));
+  });
+}
+
+}  // namespace febemesh
