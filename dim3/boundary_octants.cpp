@@ -8,6 +8,7 @@
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
+#include "core/parallel_ranges.hpp"
 #include "dim3/triangle_predicates.hpp"
 
 namespace febemesh::dim3 {
@@ -550,13 +551,18 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
   Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing, opt.outward_all_faces};
-  std::map<std::tuple<double, double, double>, std::int32_t> by_point;
-  std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
-  for (std::int32_t q = 0; q < n_lat; ++q) {
-    if (!std::isfinite(node_h[q])) continue;
-    ++res.stats.n_face_nodes;
-    ClosestPoint<3> cp = s.closest_point(oc.points[q]);
-    if (!proj.admissible(oc.points[q], cp.point, node_dirs[q], cp.where.patch)) {
+  // Each node's projection depends on the node alone: found on opt.n_threads threads, then
+  // counted, shared and numbered in node order (the same nodes for every thread count).
+  enum class How : std::uint8_t { none, closest, next_normal, ray, blind, problem };
+  std::vector<ClosestPoint<3>> found(static_cast<std::size_t>(n_lat));
+  std::vector<How> how(static_cast<std::size_t>(n_lat), How::none);
+  for_each_range(static_cast<std::size_t>(n_lat), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t q = begin; q < end; ++q) {
+      if (!std::isfinite(node_h[q])) continue;
+      ClosestPoint<3>& cp = found[q];
+      cp = s.closest_point(oc.points[q]);
+      how[q] = How::closest;
+      if (proj.admissible(oc.points[q], cp.point, node_dirs[q], cp.where.patch)) continue;
       // The next local minima of the distance, then rays along the free faces' normals.
       const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);
       std::size_t pick = cands.size();
@@ -564,16 +570,28 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
         if (proj.admissible(oc.points[q], cands[k].point, node_dirs[q], cands[k].where.patch)) pick = k;
       if (pick < cands.size()) {
         cp = cands[pick];
-        ++res.stats.n_next_normal;
+        how[q] = How::next_normal;
       } else if (opt.rays && ray_projection(s, proj, oc.points[q], node_dirs[q], 4.0 * node_h[q], cp)) {
-        ++res.stats.n_ray;
-      } else if (opt.blind_closest) {
-        // Keep the closest point: the untangling of the templates decides (pipeline3d).
-        ++res.stats.n_blind;
+        how[q] = How::ray;
       } else {
-        res.problems.push_back({oc.points[q], "no admissible projection onto the surface", true});
-        continue;
+        // Keep the closest point (blind_closest): the untangling of the templates decides
+        // (pipeline3d).
+        how[q] = opt.blind_closest ? How::blind : How::problem;
       }
+    }
+  });
+  std::map<std::tuple<double, double, double>, std::int32_t> by_point;
+  std::vector<std::vector<std::int32_t>> sources;  // per surface node - n_lat: its face nodes
+  for (std::int32_t q = 0; q < n_lat; ++q) {
+    if (how[q] == How::none) continue;
+    ++res.stats.n_face_nodes;
+    const ClosestPoint<3>& cp = found[q];
+    if (how[q] == How::next_normal) ++res.stats.n_next_normal;
+    if (how[q] == How::ray) ++res.stats.n_ray;
+    if (how[q] == How::blind) ++res.stats.n_blind;
+    if (how[q] == How::problem) {
+      res.problems.push_back({oc.points[q], "no admissible projection onto the surface", true});
+      continue;
     }
     const auto key = std::make_tuple(cp.point[0], cp.point[1], cp.point[2]);
     const auto it = by_point.find(key);

@@ -118,6 +118,7 @@ struct BoundaryOctantOptions {
   /// min_outward must hold for every free face of the node, not just one.
   bool outward_all_faces = false;
   bool rays = true;                  ///< try rays along the free faces' normals
+  int n_threads = 1;                 ///< threads for the projections (the result is the same for any)
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes
   double edge_radius = 0.35;         ///< project nodes within this many face sizes onto a feature line

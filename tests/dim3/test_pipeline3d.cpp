@@ -140,3 +140,27 @@ TEST_CASE("tet_optimize untangles a displaced centre node and keeps the corners"
   // The best centre is the cube's centre: every cone then has a 45 degree dihedral angle.
   CHECK(sq.min_dihedral_after_deg > 38.0);
 }
+
+// Threads (issue 8): the projections of the boundary octants, the classification, the smoothing
+// and the tet optimiser run on opt.n_threads; the mesh and the counts must not depend on it.
+// Spool at level 3: the first tree's projections include next local minima (4 of them).
+TEST_CASE("mesh3d gives the same mesh and counts on 1 and 2 threads", "[pipeline3d][threads]") {
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off");
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  const Result3d one = mesh3d(s, opt);
+  opt.n_threads = 2;
+  const Result3d two = mesh3d(s, opt);
+  REQUIRE(one.fe.mesh.solid.size() > 10000);
+  CHECK(one.stats.n_next_normal > 0);
+  CHECK(one.fe.mesh.points == two.fe.mesh.points);  // bit for bit
+  CHECK(one.fe.mesh.solid.node == two.fe.mesh.solid.node);
+  CHECK(one.fe.mesh.interface.node == two.fe.mesh.interface.node);
+  CHECK(one.stats.n_surface_nodes == two.stats.n_surface_nodes);
+  CHECK(one.stats.n_shared_projections == two.stats.n_shared_projections);
+  CHECK(one.stats.n_next_normal == two.stats.n_next_normal);
+  CHECK(one.stats.n_ray == two.stats.n_ray);
+  CHECK(one.stats.n_blind == two.stats.n_blind);
+  CHECK(one.n_optimize_moves == two.n_optimize_moves);
+}
