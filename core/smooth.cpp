@@ -65,21 +65,17 @@ Csr edge_neighbours(std::size_t n, const Elements& els, std::vector<std::uint8_t
       for (auto i = first + (first != last); i < last; ++i)
         for (auto j = i; j != first && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
     }
-    if (once) {
-      for (auto it = first; it != last;) {
-        auto run = it + 1;
-        while (run != last && *run == *it) ++run;
-        const auto uses = (run - it) / (*it == static_cast<std::int32_t>(v) ? 2 : 1);  // (v, v) lists v twice
-        if (uses == 1) (*once)[v] = 1;
-        it = run;
-      }
-    }
-    last = std::unique(first, last);
-    const bool self = std::binary_search(first, last, static_cast<std::int32_t>(v));
+    // One pass over the sorted list: each run's value once (v itself twice: an edge (v, v)
+    // lists v twice per use), the runs of a single use flagging v for `once`.
+    const auto self = static_cast<std::int32_t>(v);
     g.start[v] = out;
-    for (auto it = first; it != last; ++it) {
-      g.item[out++] = *it;
-      if (self && *it == static_cast<std::int32_t>(v)) g.item[out++] = *it;
+    for (auto it = first; it != last;) {
+      auto run = it + 1;
+      while (run != last && *run == *it) ++run;
+      if (once && run - it == (*it == self ? 2 : 1)) (*once)[v] = 1;
+      g.item[out++] = *it;  // out never passes it: lists only shrink, and v's run has two entries
+      if (*it == self) g.item[out++] = *it;
+      it = run;
     }
     begin = end;
   }
