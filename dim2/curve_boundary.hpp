@@ -147,6 +147,7 @@ class CurveBoundary final : public Boundary<2> {
 
   template <typename NodeTest, typename LeafVisit>
   void traverse(NodeTest&& test, LeafVisit&& visit) const;
+  void build_ray_bands();
 
   Domain domain_;
   std::vector<std::uint8_t> hole_;
@@ -155,6 +156,12 @@ class CurveBoundary final : public Boundary<2> {
   std::vector<Piece> pieces_;             ///< in BVH order
   std::vector<std::vector<int>> rec_of_;  ///< [loop][piece] -> index into pieces_
   std::vector<Node> nodes_;
+  /// is_inside's index: band_y_ holds the pieces' distinct control-box y bounds, ascending; a
+  /// point with j of them below its y can be crossed (ray_crossings != 0) only by the pieces
+  /// band_piece_[band_first_[j] .. band_first_[j + 1]), those with lo.y < y <= hi.y. Empty
+  /// (the BVH answers) when it would be large or a bound is not finite.
+  std::vector<double> band_y_;
+  std::vector<std::int32_t> band_first_, band_piece_;
   std::vector<CurveCorner> corners_;
   std::vector<std::vector<int>> corner_of_;       ///< [loop][piece] -> corner index or -1
   std::vector<std::vector<int>> level_junctions_;  ///< per loop: junctions with a level, ascending

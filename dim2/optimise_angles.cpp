@@ -26,6 +26,26 @@ double polygon_quality(const P2* pts, int n) {
   return worst / (n == 3 ? triangle_bar_deg : quad_bar_deg);
 }
 
+/// How bad the worst corner of the polygon with nodes ev (n corners, CCW) is, without atan2:
+/// triangles their largest corner cotangent, quads their largest |cotangent| (q falls as it
+/// rises, for each kind); +inf when a corner is reflex or inverted or the quotient is not finite
+/// (then only q itself tells). With n a template parameter (3, 4) the indices need no division.
+template <int N = 0> double polygon_badness(const P2* points, const VertexId* ev, int n_runtime = N) {
+  const int n = N > 0 ? N : n_runtime;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  double worst = -inf;
+  for (int k = 0; k < n; ++k) {
+    const P2 &prev = points[ev[(k + n - 1) % n].v], &cur = points[ev[k].v], &next = points[ev[(k + 1) % n].v];
+    const P2 a = prev - cur, b = next - cur;
+    const double cr = b[0] * a[1] - b[1] * a[0];
+    if (!(cr > 0)) return inf;
+    const double c = a.dot(b) / cr;
+    if (!std::isfinite(c)) return inf;
+    worst = std::max(worst, n == 3 ? c : std::abs(c));
+  }
+  return worst;
+}
+
 }  // namespace
 
 double angle_quality(const Mesh<2>& m, std::size_t e) {
@@ -62,7 +82,10 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // level 9).
   std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
   std::vector<std::uint8_t> listed(n_nodes, 0);
-  nbr.reserve(first.back());
+  // A node has as many edge neighbours as elements, one more on the boundary (a manifold
+  // mesh): reserving only the elements' count made the last push_back double the array, 8 MB
+  // with the old 4 MB still held, this run's memory peak (flange level 9, massif).
+  nbr.reserve(static_cast<std::size_t>(first.back()) + n_nodes);
   for (std::size_t v = 0; v < n_nodes; ++v) {
     const std::size_t begin = nbr.size();
     for (std::int32_t k = first[v]; k < first[v + 1]; ++k) {
@@ -117,25 +140,15 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   const double quad_deg = quad_bar_deg * opt.target + 1e-3;
   const double tri_cot = tri_deg < 90.0 ? 1.0 / std::tan(tri_deg * M_PI / 180.0) : -1e300;
   const double quad_cot = quad_deg < 90.0 ? 1.0 / std::tan(quad_deg * M_PI / 180.0) : -1e300;
-  // How bad an element's worst corner is, without atan2: triangles their largest corner
-  // cotangent, quads their largest |cotangent| (q falls as it rises, for each kind); +inf when
-  // a corner is reflex or inverted or the quotient is not finite (then only q itself tells).
+  // How bad an element's worst corner is (polygon_badness).
   constexpr double inf = std::numeric_limits<double>::infinity();
   auto badness = [&](std::size_t e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     const int n = m.solid.n_nodes_of(id);
     const VertexId* ev = m.solid.nodes(id);
-    double worst = -inf;
-    for (int k = 0; k < n; ++k) {
-      const P2 &prev = m.points[ev[(k + n - 1) % n].v], &cur = m.points[ev[k].v], &next = m.points[ev[(k + 1) % n].v];
-      const P2 a = prev - cur, b = next - cur;
-      const double cr = b[0] * a[1] - b[1] * a[0];
-      if (!(cr > 0)) return inf;
-      const double c = a.dot(b) / cr;
-      if (!std::isfinite(c)) return inf;
-      worst = std::max(worst, n == 3 ? c : std::abs(c));
-    }
-    return worst;
+    if (n == 3) return polygon_badness<3>(m.points.data(), ev);
+    if (n == 4) return polygon_badness<4>(m.points.data(), ev);
+    return polygon_badness(m.points.data(), ev, n);
   };
   auto clearly_above = [&](std::size_t e) {
     return badness(e) < (m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? tri_cot : quad_cot);
