@@ -52,6 +52,8 @@ struct Options3d {
   int escobar_sweeps = 100;          ///< last-resort untangling sweeps by the Escobar objective (0 = none)
   int optimize_sweeps = 16;          ///< node-by-node dihedral-angle sweeps after smoothing
   double target_dihedral_deg = 30.0; ///< nodes whose tets all reach this angle are left alone
+  /// In those sweeps, nodes snapped onto a feature line slide along it (else they stay put).
+  bool slide_feature_nodes = true;
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).

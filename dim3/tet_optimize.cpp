@@ -319,6 +319,21 @@ struct Optimizer {
   bool is_surface(std::int32_t v) const {
     return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0;
   }
+  bool is_line(std::int32_t v) const {
+    return opt.slide && !opt.on_line.empty() && opt.on_line[v] && is_surface(v);
+  }
+  /// Where node v (at x0) goes for candidate c: c itself inside, its closest surface point on
+  /// the surface, the nearby point of its line on a feature line.
+  void place(std::int32_t v, const P3& x0, const P3& c, P3& x, BoundaryLocation& w) const {
+    if (is_line(v)) {
+      const LineSlide ls = opt.slide(x0, where[v], c);
+      x = ls.point, w = ls.where;
+    } else if (is_surface(v)) {
+      std::tie(x, w) = opt.project(c);
+    } else {
+      x = c;
+    }
+  }
   bool movable(std::int32_t v) const {
     if (!opt.fixed.empty() && opt.fixed[v]) return false;
     if (is_surface(v) && !opt.project) return false;
@@ -408,7 +423,7 @@ struct Optimizer {
     }
     if (sum.norm() > 0) dirs[n_dirs++] = sum.normalized();
 
-    std::array<P3, 10 + max_tangent_candidates> cands;
+    std::array<P3, 10 + std::max(max_tangent_candidates, 8)> cands;
     int n_cands = 0;
     P3 centroid = P3::Zero();
     for (std::int32_t k = nb_start[v]; k < nb_start[v + 1]; ++k) centroid += mesh.points[nbs[k]];
@@ -417,22 +432,28 @@ struct Optimizer {
     cands[n_cands++] = 0.5 * (centroid + x0);
     for (int i = 0; i < n_dirs; ++i)
       for (double s : {0.25, 0.08, 0.025, 0.006}) cands[n_cands++] = x0 + s * len * dirs[i];
-    if (guard && !opt.untangle_only && f0 < tangent_rank)
+    if (is_line(v)) {
+      // Along the line both ways: the other candidates reach it only through their projection.
+      const P3 t = opt.slide(x0, where[v], x0).tangent;
+      if (t.norm() > 0)
+        for (double s : {0.25, 0.08, 0.025, 0.006}) cands[n_cands++] = x0 + s * len * t, cands[n_cands++] = x0 - s * len * t;
+    } else if (guard && !opt.untangle_only && f0 < tangent_rank) {
       n_cands += tangent_candidates(v, x0, len, dirs.data(), n_dirs, &cands[n_cands]);
+    }
 
     double best = f0;
     P3 best_x = x0;
     BoundaryLocation best_w = surf ? where[v] : BoundaryLocation{};
     for (int i = 0; i < n_cands; ++i) {
       const P3& c = cands[i];
-      P3 x = c;
+      P3 x;
       BoundaryLocation w;
-      if (surf) std::tie(x, w) = opt.project(c);
+      place(v, x0, c, x, w);
       double f = local_worst_above(sc, x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }
-    if (opt.untangle_only && opt.escobar && !(best > 0) && (!surf || opt.escobar_surface)) {
+    if (opt.untangle_only && opt.escobar && !(best > 0) && (!surf || opt.escobar_surface) && !is_line(v)) {
       // The max-min candidates did not untangle this node's tetrahedra: descend the smooth
       // objective instead (from the better of x0 and their best point).
       P3 ex;

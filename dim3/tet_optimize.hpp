@@ -27,6 +27,15 @@ namespace febemesh::dim3 {
 
 using SurfaceProjection = std::function<std::pair<Point<3>, BoundaryLocation>(const Point<3>&)>;
 
+/// A point on a feature line, its location on the surface and the line's unit tangent there.
+struct LineSlide {
+  Point<3> point = Point<3>::Zero();
+  BoundaryLocation where;
+  Point<3> tangent = Point<3>::Zero();
+};
+/// slide(x0, w0, x): the point of the feature line through the node at x0 (location w0) near x.
+using LineProjection = std::function<LineSlide(const Point<3>&, const BoundaryLocation&, const Point<3>&)>;
+
 struct TetOptimizeOptions {
   int max_sweeps = 40;
   /// Nodes whose worst dihedral angle is at least this stay put (degrees).
@@ -35,6 +44,11 @@ struct TetOptimizeOptions {
   std::vector<std::uint8_t> fixed;
   /// Surface nodes are those with where[v].patch >= 0; without a projection they stay put.
   SurfaceProjection project;
+  /// Per node: 1 = a feature-line node, which moves along its line only (every candidate is
+  /// brought back by `slide`, and it also tries steps along the line's tangent). Empty = none;
+  /// needs slide. Fixed nodes never move.
+  std::vector<std::uint8_t> on_line;
+  LineProjection slide;
   /// Only untangle: stop a node as soon as its tetrahedra are all positive.
   bool untangle_only = false;
   /// With untangle_only: where the max-min candidates leave a node's tetrahedra inverted,

@@ -46,6 +46,10 @@
 // 8.73 (276042 tets, 0.58%, 20 s), fandisk L4 11.50 -> 12.21 (180486 tets, 2.03%, 20 s),
 // elephant L4 1.10 -> 1.63 (1168754 tets, 0.31%, 154 s). Left under 10 deg: anchor's quad
 // bridging a convex feature edge, elephant's tetrahedra at fixed corners.
+// Issue 6, session h1 (CLI --threads 1): after the first dihedral pass, three more in which the
+// nodes snapped onto feature lines slide along them, aiming at 20 deg (the last with crease
+// moves below 20 deg): sphere966 L4 byte-identical, spool L4 10.24 -> 14.30 deg, anchor L4 8.73
+// -> 12.73, fandisk L4 12.21 -> 13.18 (same tets; volume errors within 0.01 points).
 // The sanitizer build runs sphere966 L4 and spool L4 only: the cases tagged [slow] are left out
 // by its ctest command (tests/CMakeLists.txt).
 
@@ -115,11 +119,12 @@ TEST_CASE("mesh3d data: spool level 4 (its thin flanges kept by the thickness re
   // 6) and without the buffer rule is valid at its first tree (CLI --threads 1: 163244 tets, min
   // dihedral 2.59 deg, volume error 3.22%). Its 4 tetrahedra under 10 deg stood on interface
   // caps at a concave feature line; with the nodes pushed off it and the optimiser's moves along
-  // creases: 10.24 deg, 3.17% (issue 6 asks for 10 deg).
+  // creases: 10.24 deg, 3.17% (issue 6 asks for 10 deg); with the feature-line nodes sliding
+  // along their lines (session h1): 14.30 deg, 3.17%.
   const DataRun d = mesh_and_validate("spool", 4);
   CHECK(d.thickness_refined);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 10.0);
+  CHECK(d.min_dihedral_deg >= 14.0);
   CHECK(d.volume_rel_error < 0.05);
 }
 
@@ -128,10 +133,10 @@ TEST_CASE("mesh3d data: fandisk level 4 (valid with facing projections only)", "
   // octants); the last one, projections leaving through every free face and landing on surface
   // facing it, is valid after 4 repairs with the dihedral optimiser of session 7 (CLI: 180486
   // tets, 11.50 deg, 2.03%; 3 repairs and 131238 tets before it): the CLI's repair budget.
-  // Issue 6 (the optimiser's moves along creases): 12.21 deg.
+  // Issue 6 (the optimiser's moves along creases): 12.21 deg; feature-line nodes sliding: 13.18.
   const DataRun d = mesh_and_validate("fandisk", 4, Options3d{}.max_repairs);
   CHECK(d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 12.0);
+  CHECK(d.min_dihedral_deg >= 13.0);
   CHECK(d.volume_rel_error < 0.03);
 }
 
@@ -148,11 +153,11 @@ TEST_CASE("mesh3d data: anchor level 4 (valid without the buffer rule)", "[data]
   // With the buffer rule the one-octant slabs in its two-octant-thick arms fold their boundary
   // octants (rim nodes project through the arm); the run without the buffer is valid. Issue 6:
   // 8.29 -> 8.73 deg (one of its two places under 10 deg was an interface cap at a concave
-  // feature line).
+  // feature line). Feature-line nodes sliding along their lines (session h1): 12.73 deg.
   const DataRun d = mesh_and_validate("anchor", 4);
   CHECK(d.buffer_dropped);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 8.5);
+  CHECK(d.min_dihedral_deg >= 12.5);
   CHECK(d.volume_rel_error < 0.02);
 }
 

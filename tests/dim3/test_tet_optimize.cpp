@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <rapidcheck.h>
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -165,4 +166,58 @@ TEST_CASE("optimize_tets gives the same mesh on 1, 2 and 3 threads", "[tet_optim
       CHECK(same_where);
     }
   }
+}
+
+TEST_CASE("optimize_tets slides feature-line nodes along their lines only", "[tet_optimize]") {
+  // The cube's edges are the feature lines: their inner nodes, shifted along them, slide; the
+  // corners and the nodes inside its faces stay put.
+  const int n = 5;
+  const double hi = n - 1;
+  Mesh<3> m = jittered_cube(0.6, 5, n);
+  std::vector<BoundaryLocation> where(m.points.size());
+  TetOptimizeOptions opt;
+  opt.max_sweeps = 16;
+  opt.fixed.assign(m.points.size(), 0);
+  opt.on_line.assign(m.points.size(), 0);
+  std::vector<int> free_axis(m.points.size(), -1);
+  std::size_t n_line = 0;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    int on = 0, axis = -1;
+    for (int d = 0; d < 3; ++d) {
+      if (m.points[v][d] == 0.0 || m.points[v][d] == hi) ++on;
+      else axis = d;
+    }
+    opt.fixed[v] = on == 1 || on == 3 ? 1 : 0;
+    if (on != 2) continue;
+    free_axis[v] = axis;
+    m.points[v][axis] += (v % 2 ? 0.3 : -0.3);
+    where[v].patch = 0;
+    where[v].kind = BoundaryLocation::Kind::FeatureEdge;
+    opt.on_line[v] = 1;
+    ++n_line;
+  }
+  REQUIRE(n_line == 12 * (n - 2));
+  const double before = min_dihedral(m);
+  opt.project = [](const P3& p) { return std::make_pair(p, BoundaryLocation{}); };  // unused here
+  opt.slide = [hi](const P3& x0, const BoundaryLocation& w0, const P3& x) {
+    LineSlide s;
+    s.point = x0;
+    s.where = w0;
+    for (int d = 0; d < 3; ++d)
+      if (x0[d] != 0.0 && x0[d] != hi) s.point[d] = std::clamp(x[d], 0.0, hi), s.tangent[d] = 1.0;
+    return s;
+  };
+  const Mesh<3> start = m;
+  const TetOptimizeStats st = optimize_tets(m, where, opt);
+  CHECK(st.inverted_after == 0);
+  CHECK(min_dihedral(m) > before);
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    if (free_axis[v] < 0) continue;
+    for (int d = 0; d < 3; ++d)
+      if (d != free_axis[v]) CHECK(m.points[v][d] == start.points[v][d]);  // still on its edge
+    CHECK(where[v].kind == BoundaryLocation::Kind::FeatureEdge);
+    moved += m.points[v] != start.points[v] ? 1 : 0;
+  }
+  CHECK(moved > 0);
 }
