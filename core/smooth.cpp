@@ -10,6 +10,7 @@
 #include "core/guard_order.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/quality.hpp"
 
 namespace febemesh {
@@ -116,7 +117,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   std::vector<std::uint8_t> on_boundary(n, 0);
   const Csr neighbours = edge_neighbours(n, mesh.solid, polygons ? &on_boundary : nullptr);
   Elements boundary;
-  if (!polygons) {
+  const bool known = options.boundary_fixed && !options.project && options.fixed.size() == n;
+  if (!polygons && !known) {
     for (const BoundaryFacet& b : boundary_facets(mesh.solid)) {
       // The boundary's own graph is needed only when boundary nodes slide.
       if (options.project) boundary.add(b.facet.type, b.facet.node.data(), b.facet.n);
@@ -157,7 +159,9 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     for (const double sj : scaled) q = std::min(q, sj);
     return scaled.empty() ? 0.0 : q;
   };
-  for (std::size_t e = 0; e < mesh.solid.size(); ++e) set_state(static_cast<std::int32_t>(e), element_state(static_cast<std::int32_t>(e)));
+  for_each_range(mesh.solid.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) set_state(static_cast<std::int32_t>(e), element_state(static_cast<std::int32_t>(e)));
+  });
   stats.min_quality_before = min_quality();
   // settled[v]: 1 if v's target was where it stands, 2 if its move was rejected, and no node of
   // its elements has moved since; its target, its elements' states and the trial states would

@@ -730,6 +730,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       so.n_threads = opt.n_threads;
       so.fixed.assign(fe.mesh.points.size(), 0);
       for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
+      so.boundary_fixed = true;  // the solid's boundary is the surface faces, all of whose nodes are on it
       const SmoothStats ss = smooth(fe.mesh, so);
       r.n_smoothing_accepted = ss.moves_accepted;
       r.n_smoothing_rejected = ss.moves_rejected;

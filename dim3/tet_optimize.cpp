@@ -1,6 +1,7 @@
 #include "dim3/tet_optimize.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -9,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "core/ordered_sweep.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -558,10 +560,14 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
       for (std::int32_t v : o.faces[f]) o.f_incident[fill[v]++] = static_cast<std::int32_t>(f);
   }
   const auto count_folded = [&] {
-    std::size_t k = 0;
-    for (std::size_t f = 0; f < o.faces.size(); ++f)
-      if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0) ++k;
-    return k;
+    std::atomic<std::size_t> folded{0};
+    for_each_range(o.faces.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+      std::size_t k = 0;
+      for (std::size_t f = begin; f < end; ++f)
+        if (o.face_quality(static_cast<std::int32_t>(f), -1, P3::Zero(), P3::Zero()) < 0) ++k;
+      folded += k;
+    });
+    return folded.load();
   };
 
   TetOptimizeStats st;
@@ -582,10 +588,15 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   o.target_rank = angle_rank(target);
   o.tangent_rank = angle_rank(opt.tangent_below_deg * pi / 180.0);
   bool any_active = false;
+  for_each_range(o.tets.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Tet& t = o.tets[i];
+      o.tet_q[i] = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+    }
+  });
   for (std::size_t i = 0; i < o.tets.size(); ++i) {
     const Tet& t = o.tets[i];
-    const double q = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
-    o.tet_q[i] = q;
+    const double q = o.tet_q[i];
     if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
       any_active = true;
       for (std::int32_t v : t) active[v] = 1;
