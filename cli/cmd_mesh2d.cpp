@@ -143,6 +143,7 @@ int run(const std::vector<std::string>& argv) {
     const Box<2> bb = curve.bounding_box();
     vo.boundary_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
     vo.boundary_tolerance = 1e-10 * (bb.hi - bb.lo).norm();
+    vo.n_threads = opt.n_threads;
     valid = validate<2>(r.fe.mesh, vo);
   }
   if (!valid.valid && !args.has("--no-validate"))

@@ -142,7 +142,8 @@ int run(const std::vector<std::string>& argv) {
   std::future<dim3::Fidelity3d> measuring = std::async(launch, [&] {
     return dim3::measure_fidelity(opt.hex_dominant ? triangulated_interface(mesh) : mesh, surface);
   });
-  const ValidateOptions<3> vo = dim3::surface_validation(surface);
+  ValidateOptions<3> vo = dim3::surface_validation(surface);
+  vo.n_threads = opt.n_threads;
   const ValidationReport vr = validate(mesh, vo);
   const QualitySummary q = summarize_quality(mesh, 10.0, opt.n_threads);
   const dim3::Fidelity3d fid = measuring.get();

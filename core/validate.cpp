@@ -12,6 +12,7 @@
 #include <type_traits>
 
 #include "core/mesh_topology.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/point_grid.hpp"
 #include "core/quality.hpp"
 
@@ -312,16 +313,29 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   }
   if (r.bad_elements != 0) return r;  // the checks below index nodes and tables by element type
 
+  // The checks below look at each element, node, edge or facet on its own: on n_threads, the
+  // ones that fail are marked, then reported in order on this thread (the same report).
+  const auto marked = [&](std::size_t n, const auto& fails) {
+    std::vector<std::uint8_t> mark(n, 0);
+    for_each_range(n, options.n_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) mark[i] = fails(i) ? 1 : 0;
+    });
+    return mark;
+  };
+
   // Orientation: every corner.
-  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+  const auto corner_jacobian = [&](std::size_t e) {
     const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, pts);
-    const double j = min_corner_jacobian<Dim>(mesh.solid.type[e], ep.span());
-    if (!(j > 0.0)) {
-      ++r.inverted;
-      problems.add([&](auto& os) {
-        os << "inverted solid " << fmt_element<Dim>(mesh.solid, e, pts) << ": min corner Jacobian " << j;
-      });
-    }
+    return min_corner_jacobian<Dim>(mesh.solid.type[e], ep.span());
+  };
+  const std::vector<std::uint8_t> inverted = marked(mesh.solid.size(), [&](std::size_t e) { return !(corner_jacobian(e) > 0.0); });
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    if (!inverted[e]) continue;
+    const double j = corner_jacobian(e);
+    ++r.inverted;
+    problems.add([&](auto& os) {
+      os << "inverted solid " << fmt_element<Dim>(mesh.solid, e, pts) << ": min corner Jacobian " << j;
+    });
   }
 
   // Conformity: group facet uses by key.
@@ -439,12 +453,18 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     Box<Dim> all = Box<Dim>::empty();
     for (const auto id : used_ids) all.expand(pts[id]);
     const double tol = used_ids.empty() ? 0.0 : options.duplicate_rel_tol * all.extent().norm();
-    for (const auto i : used_ids) {
+    const auto first_within = [&](std::int32_t i) {
       std::int32_t first = i;
       grid.query(inflated_box<Dim>({pts[i]}, tol), [&](std::int32_t j) {
         if (j < first && (pts[j] - pts[i]).norm() <= tol) first = j;
       });
-      if (first == i) continue;
+      return first;
+    };
+    const std::vector<std::uint8_t> duplicate =
+        marked(used_ids.size(), [&](std::size_t k) { return first_within(used_ids[k]) != used_ids[k]; });
+    for (std::size_t k = 0; k < used_ids.size(); ++k) {
+      if (!duplicate[k]) continue;
+      const std::int32_t i = used_ids[k], first = first_within(i);
       ++r.duplicate_nodes;
       problems.add([&](auto& os) { os << "node " << i << " duplicates node " << first << " at " << fmt<Dim>(pts[i]); });
     }
@@ -464,12 +484,25 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       ++r.hanging_nodes;
       problems.add([&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
     };
+    const auto edge_box = [&](const std::array<VertexId, 2>& edge) {
+      const Point<Dim>&pa = pts[edge[0].v], &pb = pts[edge[1].v];
+      return inflated_box<Dim>({pa, pb}, rel * (pb - pa).norm());
+    };
+    const std::vector<std::uint8_t> edge_hit = marked(edges.size(), [&](std::size_t k) {
+      const VertexId a = edges[k][0], b = edges[k][1];
+      bool hit = false;
+      grid.query(edge_box(edges[k]), [&](std::int32_t c) {
+        hit = hit || (c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pts[a.v], pts[b.v], rel));
+      });
+      return hit;
+    });
     std::vector<std::int32_t> hits;
-    for (const auto& edge : edges) {
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+      if (!edge_hit[k]) continue;
+      const auto& edge = edges[k];
       const VertexId a = edge[0], b = edge[1];  // named, not bound: lambdas capture them (clang 14)
       const Point<Dim>&pa = pts[a.v], &pb = pts[b.v];
-      const double margin = rel * (pb - pa).norm();
-      const Box<Dim> box = inflated_box<Dim>({pa, pb}, margin);
+      const Box<Dim> box = edge_box(edge);
       auto on_edge = [&](std::int32_t c) { return c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pa, pb, rel); };
       auto report_edge = [&](std::int32_t c) { report(c, "edge " + std::to_string(a.v) + "-" + std::to_string(b.v)); };
       hits.clear();
@@ -486,8 +519,8 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       }
     }
     if constexpr (Dim == 3) {
-      for (std::size_t i = 0; i < uses.size(); ++i) {
-        if (i > 0 && uses[i].key == uses[i - 1].key) continue;
+      // Calls at(c) for every node c on the interior of use i's facet.
+      const auto on_interior = [&](std::size_t i, const auto& at) {
         const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
         Box<3> box = Box<3>::empty();
         double h = 0.0;
@@ -500,9 +533,17 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
-          if (on_facet_interior(pts[c], f, pts, rel)) report(c, "facet " + fmt_key(uses[i].key));
+          if (on_facet_interior(pts[c], f, pts, rel)) at(c);
         });
-      }
+      };
+      const std::vector<std::uint8_t> facet_hit = marked(uses.size(), [&](std::size_t i) {
+        if (i > 0 && uses[i].key == uses[i - 1].key) return false;
+        bool hit = false;
+        on_interior(i, [&](std::int32_t) { hit = true; });
+        return hit;
+      });
+      for (std::size_t i = 0; i < uses.size(); ++i)
+        if (facet_hit[i]) on_interior(i, [&](std::int32_t c) { report(c, "facet " + fmt_key(uses[i].key)); });
     }
   }
 
@@ -512,8 +553,13 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     for (const VertexId v : mesh.interface.node) nodes.push_back(v.v);
     std::sort(nodes.begin(), nodes.end());
     nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-    for (const auto v : nodes) {
-      const double d = std::abs(options.boundary_distance(pts[v]));
+    std::vector<double> distance(nodes.size());
+    for_each_range(nodes.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) distance[k] = std::abs(options.boundary_distance(pts[nodes[k]]));
+    });
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const std::int32_t v = nodes[k];
+      const double d = distance[k];
       r.max_boundary_distance = std::max(r.max_boundary_distance, d);
       if (!(d <= options.boundary_tolerance)) {
         ++r.off_boundary_nodes;

@@ -27,6 +27,9 @@ template <int Dim> struct ValidateOptions {
   double duplicate_rel_tol = 1e-12;
   /// How many human-readable problems to keep.
   int max_problems = 20;
+  /// Threads for the per-element, per-node and per-edge checks (boundary_distance must then be
+  /// safe to call concurrently); the report is the same for every count.
+  int n_threads = 1;
 };
 
 struct ValidationReport {

@@ -255,3 +255,30 @@ TEST_CASE("euler_characteristic of tetrahedra agrees with its sorting twin", "[v
   bad.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{1}, VertexId{1}, VertexId{7}});
   CHECK(euler_characteristic(bad) == euler_characteristic_ref(bad));
 }
+
+TEMPLATE_TEST_CASE_SIG("the report is the same on 1, 2 and 3 threads", "[validate][threads]", ((int Dim), Dim), 2, 3) {
+  // Hanging nodes (the 2:1 mesh), an inverted element, a duplicate node and interface nodes
+  // off a made-up boundary: every check that runs on threads finds something.
+  Mesh<Dim> mesh = test::hanging_mesh<Dim>(true);
+  std::swap(mesh.solid.node[1], mesh.solid.node[2]);  // the first simplex turned over
+  const VertexId twin = mesh.add_point(mesh.points[mesh.solid.node[0].v]);
+  mesh.solid.node[mesh.solid.offset[3]] = twin;  // a node used by the fourth simplex only, duplicated
+  ValidateOptions<Dim> vo;
+  vo.expected_euler = 1;
+  vo.boundary_distance = [](const Point<Dim>& p) { return p[0] - 1.0; };  // the plane x = 1
+  vo.boundary_tolerance = 1e-9;
+  vo.max_problems = 1000;
+  const ValidationReport one = validate<Dim>(mesh, vo);
+  CHECK(one.inverted > 0);
+  CHECK(one.hanging_nodes > 0);
+  CHECK(one.duplicate_nodes > 0);
+  CHECK(one.off_boundary_nodes > 0);
+  for (const int threads : {2, 3}) {
+    vo.n_threads = threads;
+    const ValidationReport r = validate<Dim>(mesh, vo);
+    CAPTURE(threads);
+    CHECK(r.summary() == one.summary());  // the counts and every problem, in the same order
+    CHECK(r.max_boundary_distance == one.max_boundary_distance);
+    CHECK(r.euler == one.euler);
+  }
+}
