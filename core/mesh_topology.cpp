@@ -429,6 +429,25 @@ std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
   return sorted;
 }
 
+void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
+                               std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed) {
+  const std::size_t begin = out.size();
+  for (const std::int32_t e : elems) {
+    const ElemId id{e};
+    const int n = els.n_nodes_of(id);
+    const VertexId* ev = els.nodes(id);
+    for (int k = 0; k < n; ++k) {
+      if (ev[k].v != v) continue;
+      for (const std::int32_t w : {ev[(k + 1) % n].v, ev[(k + n - 1) % n].v})
+        if (!listed[w]) listed[w] = 1, out.push_back(w);
+    }
+  }
+  for (std::size_t i = begin; i < out.size(); ++i) {
+    listed[out[i]] = 0;
+    for (std::size_t j = i; j > begin && out[j] < out[j - 1]; --j) std::swap(out[j], out[j - 1]);
+  }
+}
+
 std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els) {
   std::vector<std::array<VertexId, 2>> edges = edge_list(els);
   std::sort(edges.begin(), edges.end(), [](const auto& x, const auto& y) {

@@ -69,6 +69,14 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid);
 
 /// Distinct edges of `els` as sorted node pairs, sorted.
 std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els);
+
+/// Appends to `out` the distinct edge neighbours of node v in the polygons `elems` (the nodes
+/// before and after v in each), ascending. `listed` has a byte per node, all 0; it marks the
+/// ones seen and is all 0 again on return. (The 2D smoothing and angle optimiser, per node: a
+/// mark and an insertion sort instead of std::sort and std::unique, 428M -> 388M instructions
+/// in optimise_angles at flange level 9.)
+void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
+                               std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed);
 /// Slow twin of unique_edges (one comparison sort): the same vector.
 std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els);
 

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
+#include "core/mesh_topology.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -373,21 +374,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       } else {
         // The distinct edge neighbours, ascending (the centroid below sums them in that order).
         nb.clear();
-        const auto self = static_cast<std::int32_t>(v);
-        for (const std::int32_t e : elems) {
-          const ElemId id{e};
-          const int n = m.solid.n_nodes_of(id);
-          const VertexId* ev = m.solid.nodes(id);
-          for (int k = 0; k < n; ++k) {
-            if (ev[k].v != self) continue;
-            for (const std::int32_t w : {ev[(k + 1) % n].v, ev[(k + n - 1) % n].v})
-              if (!listed[w]) listed[w] = 1, nb.push_back(w);
-          }
-        }
-        for (std::size_t i = 0; i < nb.size(); ++i) {
-          listed[nb[i]] = 0;
-          for (std::size_t j = i; j > 0 && nb[j] < nb[j - 1]; --j) std::swap(nb[j], nb[j - 1]);
-        }
+        append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v), elems, nb, listed);
       }
       if (nb.empty()) continue;
       P2 target = P2::Zero();

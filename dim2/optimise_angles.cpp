@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
+
+#include "core/mesh_topology.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -76,10 +79,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
     }
   }
-  // Edge neighbours of each node from its incident elements (each node's few, sorted locally):
-  // duplicates are caught by a mark, cleared after the node, and the list insertion-sorted
-  // (std::sort and std::unique per node: optimise_angles 428M -> 388M instructions at flange
-  // level 9).
+  // Edge neighbours of each node from its incident elements (append_polygon_neighbours).
   std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
   std::vector<std::uint8_t> listed(n_nodes, 0);
   // A node has as many edge neighbours as elements, one more on the boundary (a manifold
@@ -87,21 +87,9 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // with the old 4 MB still held, this run's memory peak (flange level 9, massif).
   nbr.reserve(static_cast<std::size_t>(first.back()) + n_nodes);
   for (std::size_t v = 0; v < n_nodes; ++v) {
-    const std::size_t begin = nbr.size();
-    for (std::int32_t k = first[v]; k < first[v + 1]; ++k) {
-      const ElemId id{incident[k]};
-      const int n = m.solid.n_nodes_of(id);
-      const VertexId* ev = m.solid.nodes(id);
-      for (int j = 0; j < n; ++j) {
-        if (ev[j].v != static_cast<std::int32_t>(v)) continue;
-        for (const std::int32_t w : {ev[(j + 1) % n].v, ev[(j + n - 1) % n].v})
-          if (!listed[w]) listed[w] = 1, nbr.push_back(w);
-      }
-    }
-    for (std::size_t i = begin; i < nbr.size(); ++i) {
-      listed[nbr[i]] = 0;
-      for (std::size_t j = i; j > begin && nbr[j] < nbr[j - 1]; --j) std::swap(nbr[j], nbr[j - 1]);
-    }
+    append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v),
+                              std::span<const std::int32_t>(incident.data() + first[v], incident.data() + first[v + 1]), nbr,
+                              listed);
     nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
   }
 
