@@ -484,37 +484,37 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       ++r.hanging_nodes;
       problems.add([&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
     };
-    const auto edge_box = [&](const std::array<VertexId, 2>& edge) {
-      const Point<Dim>&pa = pts[edge[0].v], &pb = pts[edge[1].v];
+    // Edge k's box, and whether node c lies on its interior.
+    const auto edge_box = [&](std::size_t k) {
+      const Point<Dim>&pa = pts[edges[k][0].v], &pb = pts[edges[k][1].v];
       return inflated_box<Dim>({pa, pb}, rel * (pb - pa).norm());
     };
-    const std::vector<std::uint8_t> edge_hit = marked(edges.size(), [&](std::size_t k) {
+    const auto on_edge = [&](std::size_t k, std::int32_t c) {
       const VertexId a = edges[k][0], b = edges[k][1];
+      return c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pts[a.v], pts[b.v], rel);
+    };
+    const std::vector<std::uint8_t> edge_hit = marked(edges.size(), [&](std::size_t k) {
       bool hit = false;
-      grid.query(edge_box(edges[k]), [&](std::int32_t c) {
-        hit = hit || (c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pts[a.v], pts[b.v], rel));
-      });
+      grid.query(edge_box(k), [&](std::int32_t c) { hit = hit || on_edge(k, c); });
       return hit;
     });
     std::vector<std::int32_t> hits;
     for (std::size_t k = 0; k < edges.size(); ++k) {
       if (!edge_hit[k]) continue;
-      const auto& edge = edges[k];
-      const VertexId a = edge[0], b = edge[1];  // named, not bound: lambdas capture them (clang 14)
-      const Point<Dim>&pa = pts[a.v], &pb = pts[b.v];
-      const Box<Dim> box = edge_box(edge);
-      auto on_edge = [&](std::int32_t c) { return c != a.v && c != b.v && on_open_segment<Dim>(pts[c], pa, pb, rel); };
-      auto report_edge = [&](std::int32_t c) { report(c, "edge " + std::to_string(a.v) + "-" + std::to_string(b.v)); };
+      const Box<Dim> box = edge_box(k);
+      auto report_edge = [&](std::int32_t c) {
+        report(c, "edge " + std::to_string(edges[k][0].v) + "-" + std::to_string(edges[k][1].v));
+      };
       hits.clear();
       grid.query(box, [&](std::int32_t c) {
-        if (on_edge(c)) hits.push_back(c);
+        if (on_edge(k, c)) hits.push_back(c);
       });
       if (hits.size() == 1) {
         report_edge(hits[0]);
       } else if (hits.size() > 1) {  // the k-d tree's order, as the reports always came
         if (!tree) tree.emplace(pts, used_ids);
         tree->query(box, [&](std::int32_t c) {
-          if (on_edge(c)) report_edge(c);
+          if (on_edge(k, c)) report_edge(c);
         });
       }
     }
