@@ -231,13 +231,10 @@ std::size_t slide_on_lines(const SurfaceBoundary& s, const OctantComplex& oc, co
     P3 best_q = x0;
     const auto visit = [&](std::int32_t i) {
       const P3 &a = l.points[i], &b = l.points[i + 1];
-      const P3 ab = b - a;
-      const double len2 = ab.squaredNorm();
-      const double t = len2 > 0 ? std::clamp((x - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-      const P3 q = a + t * ab;
+      const P3 q = a + closest_on_segment(x, a, b) * (b - a);
       const double d = (q - x).norm();
       if (d < best_d) best_d = d, best = i, best_q = q;
-      return std::sqrt(len2);
+      return (b - a).norm();
     };
     visit(i0);
     for (const int dir : {1, -1}) {
