@@ -69,13 +69,15 @@ template <int Dim> class PointTree {
 class Problems {
  public:
   Problems(ValidationReport& r, int max) : r_(r), max_(max) {}
-  template <class Write> void add(Write&& write) {
+  /// One problem: what it is (ProblemSite::kind), the node it is at (-1: none) and its text.
+  template <class Write> void add(const char* kind, std::int32_t node, Write&& write) {
     ++r_.n_problems;
     if (static_cast<int>(r_.problems.size()) >= max_) return;
     std::ostringstream os;
     os.precision(17);
     write(os);
     r_.problems.push_back(os.str());
+    r_.sites.push_back({kind, node});
   }
 
  private:
@@ -117,7 +119,7 @@ template <int Dim> void check_elements(const Elements& els, int dim, const char*
                                        ValidationReport& r, Problems& problems) {
   if (els.offset.size() != els.size() + 1 || els.offset.back() != static_cast<std::int32_t>(els.node.size())) {
     ++r.bad_elements;
-    problems.add([&](auto& os) { os << group << ": offset array inconsistent with the node array"; });
+    problems.add("bad element", -1, [&](auto& os) { os << group << ": offset array inconsistent with the node array"; });
     return;
   }
   for (std::size_t e = 0; e < els.size(); ++e) {
@@ -127,7 +129,7 @@ template <int Dim> void check_elements(const Elements& els, int dim, const char*
       ok = els.nodes(id)[i].v >= 0 && static_cast<std::size_t>(els.nodes(id)[i].v) < n_points;
     if (!ok) {
       ++r.bad_elements;
-      problems.add([&](auto& os) {
+      problems.add("bad element", -1, [&](auto& os) {
         os << group << " element " << e << " (" << name(els.type[e]) << "): wrong dimension, node count or node id";
       });
     }
@@ -305,7 +307,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   for (const auto* attr : {&mesh.level, &mesh.from_boundary_cell}) {
     if (!attr->empty() && attr->size() != mesh.solid.size()) {
       ++r.attribute_mismatch;
-      problems.add([&](auto& os) {
+      problems.add("attribute array of the wrong size", -1, [&](auto& os) {
         os << (attr == &mesh.level ? "level" : "from_boundary_cell") << " has " << attr->size() << " entries for "
            << mesh.solid.size() << " solid elements";
       });
@@ -333,7 +335,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     if (!inverted[e]) continue;
     const double j = corner_jacobian(e);
     ++r.inverted;
-    problems.add([&](auto& os) {
+    problems.add("an element is inverted", mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)})[0].v, [&](auto& os) {
       os << "inverted solid " << fmt_element<Dim>(mesh.solid, e, pts) << ": min corner Jacobian " << j;
     });
   }
@@ -350,7 +352,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       boundary.push_back(uses[i]);
     } else if (j - i > 2 || uses[i].orientation == uses[i + 1].orientation) {
       ++r.nonconforming_facets;
-      problems.add([&](auto& os) {
+      problems.add("a facet does not conform", uses[i].key.v[0], [&](auto& os) {
         os << "facet " << fmt_key(uses[i].key) << " used " << (j - i) << " times"
            << (j - i == 2 ? " in the same orientation" : "") << " by solid elements";
         for (std::size_t k = i; k < j; ++k) os << " " << uses[k].elem.v;
@@ -382,7 +384,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         const VertexId a = f.node[d], b = f.node[d + 1], c = f.node[(d + 2) % 4], e = f.node[(d + 3) % 4];
         if (!is_boundary(a, b, c) || !is_boundary(a, c, e)) continue;
         ++r.nonconforming_facets;
-        problems.add([&](auto& os) {
+        problems.add("a facet does not conform", q.key.v[0], [&](auto& os) {
           os << "quad facet " << fmt_key(q.key) << " of solid element " << q.elem.v
              << " meets two triangles on its nodes, at " << fmt<Dim>(pts[q.key.v[0]]);
         });
@@ -402,7 +404,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       const std::size_t bi = static_cast<std::size_t>(it - boundary.begin());
       if (it == boundary.end() || it->key != k || matched[bi]) {
         ++r.interface_extra;
-        problems.add([&](auto& os) {
+        problems.add("an interface element is not a boundary facet", mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)})[0].v, [&](auto& os) {
           os << "interface " << fmt_element<Dim>(mesh.interface, e, pts)
              << (it != boundary.end() && it->key == k ? " repeats a boundary facet" : " is not a boundary facet of the solid");
         });
@@ -411,7 +413,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       matched[bi] = 1;
       if (orientation_of(f) != it->orientation) {
         ++r.interface_reversed;
-        problems.add([&](auto& os) {
+        problems.add("an interface element is reversed", mesh.interface.nodes(ElemId{static_cast<std::int32_t>(e)})[0].v, [&](auto& os) {
           os << "interface " << fmt_element<Dim>(mesh.interface, e, pts) << " is reversed (against solid element "
              << it->elem.v << ")";
         });
@@ -420,7 +422,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     for (std::size_t b = 0; b < boundary.size(); ++b) {
       if (matched[b]) continue;
       ++r.interface_missing;
-      problems.add([&](auto& os) {
+      problems.add("a boundary facet has no interface element", boundary[b].key.v[0], [&](auto& os) {
         os << "boundary facet " << fmt_key(boundary[b].key) << " of solid element " << boundary[b].elem.v
            << " has no interface element, at " << fmt<Dim>(pts[boundary[b].key.v[0]]);
       });
@@ -439,7 +441,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       continue;
     }
     ++r.unused_nodes;
-    problems.add([&](auto& os) { os << "node " << i << " at " << fmt<Dim>(pts[i]) << " is used by no element"; });
+    problems.add("a node is unused", static_cast<std::int32_t>(i), [&](auto& os) { os << "node " << i << " at " << fmt<Dim>(pts[i]) << " is used by no element"; });
   }
 
   // A uniform grid answers the queries (PointGrid says why; in 3D the k-d tree's node queries
@@ -466,7 +468,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       if (!duplicate[k]) continue;
       const std::int32_t i = used_ids[k], first = first_within(i);
       ++r.duplicate_nodes;
-      problems.add([&](auto& os) { os << "node " << i << " duplicates node " << first << " at " << fmt<Dim>(pts[i]); });
+      problems.add("a node is duplicated", i, [&](auto& os) { os << "node " << i << " duplicates node " << first << " at " << fmt<Dim>(pts[i]); });
     }
   }
 
@@ -482,7 +484,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       if (hanging[c]) return;
       hanging[c] = 1;
       ++r.hanging_nodes;
-      problems.add([&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
+      problems.add("a node hangs on an edge or facet", c, [&](auto& os) { os << "hanging node " << c << " at " << fmt<Dim>(pts[c]) << " on " << where; });
     };
     // Edge k's box, and whether node c lies on its interior.
     const auto edge_box = [&](std::size_t k) {
@@ -563,7 +565,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       r.max_boundary_distance = std::max(r.max_boundary_distance, d);
       if (!(d <= options.boundary_tolerance)) {
         ++r.off_boundary_nodes;
-        problems.add([&](auto& os) {
+        problems.add("an interface node is off the boundary", v, [&](auto& os) {
           os << "interface node " << v << " at " << fmt<Dim>(pts[v]) << " is " << d << " from the boundary";
         });
       }
@@ -577,7 +579,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     r.euler = Dim == 2 ? v - e + static_cast<long>(mesh.solid.size())
                        : v - e + static_cast<long>(n_unique_facets) - static_cast<long>(mesh.solid.size());
     if (options.expected_euler && *options.expected_euler != r.euler)
-      problems.add([&](auto& os) { os << "Euler characteristic " << r.euler << ", expected " << *options.expected_euler; });
+      problems.add("the Euler characteristic differs", -1, [&](auto& os) { os << "Euler characteristic " << r.euler << ", expected " << *options.expected_euler; });
   }
 
   r.valid = r.bad_elements == 0 && r.inverted == 0 && r.nonconforming_facets == 0 && r.hanging_nodes == 0 &&

@@ -4,6 +4,7 @@
 // interface nodes to the boundary, Euler characteristic. Pipeline tests call this on every output.
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -55,6 +56,14 @@ struct ValidationReport {
 
   /// The first max_problems problems, with element ids and coordinates.
   std::vector<std::string> problems;
+  /// Where problems[i] is: a short kind ("a node hangs on an edge or facet") and a node at the
+  /// problem (an element's first node; -1 for the counts that have no place: bad elements,
+  /// attribute arrays, the Euler characteristic). A pipeline refines around these.
+  struct ProblemSite {
+    const char* kind = "";
+    std::int32_t node = -1;
+  };
+  std::vector<ProblemSite> sites;
   std::size_t n_problems = 0;  ///< all problems, including those not kept
 
   /// One line per nonzero count, then the problems.
