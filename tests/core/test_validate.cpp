@@ -216,7 +216,39 @@ TEST_CASE("problems are capped and name elements and coordinates", "[validate]")
   CHECK(r.summary().find("13 more") != std::string::npos);
 }
 
-TEST_CASE("validation of a large grid is fast enough", "[validate]") {
+TEMPLATE_TEST_CASE_SIG("each kept problem has a site: its kind and a node at it", "[validate]", ((int Dim), Dim), 2, 3) {
+  // What a pipeline refines around: a hanging node names itself, an inverted element its first
+  // node, the Euler characteristic no node.
+  Mesh<Dim> mesh = test::hanging_mesh<Dim>(true);
+  std::swap(mesh.solid.node[1], mesh.solid.node[2]);  // the first simplex turned over
+  ValidateOptions<Dim> vo;
+  vo.expected_euler = 7;
+  const ValidationReport r = validate<Dim>(mesh, vo);
+  INFO(r.summary());
+  REQUIRE(r.sites.size() == r.problems.size());
+  std::size_t n_hanging = 0, n_inverted = 0, n_euler = 0;
+  for (std::size_t k = 0; k < r.sites.size(); ++k) {
+    const auto& site = r.sites[k];
+    const std::string kind = site.kind;
+    if (kind == "a node hangs on an edge or facet") {
+      ++n_hanging;
+      // The problem's text names the same node.
+      CHECK(r.problems[k].rfind("hanging node " + std::to_string(site.node) + " ", 0) == 0);
+    } else if (kind == "an element is inverted") {
+      ++n_inverted;
+      CHECK(site.node == mesh.solid.node[0].v);
+    } else if (kind == "the Euler characteristic differs") {
+      ++n_euler;
+      CHECK(site.node == -1);
+    }
+    if (site.node >= 0) CHECK(static_cast<std::size_t>(site.node) < mesh.points.size());
+  }
+  CHECK(n_hanging == r.hanging_nodes);
+  CHECK(n_inverted == r.inverted);
+  CHECK(n_euler == 1);
+}
+
+TEST_CASE("a large grid (82,944 tetrahedra) validates", "[validate]") {
   const Mesh<3> mesh = test::grid_mesh<3>(24, true);  // 82944 tets
   const ValidationReport r = validate(mesh);
   CHECK(r.valid);
