@@ -200,6 +200,7 @@ int run(const std::vector<std::string>& argv) {
                    {"edge_nodes_snapped", r.stats.n_edge_snapped},
                    {"snaps_reverted", r.n_snaps_reverted},
                    {"degenerate_cones_dropped", r.fe.n_dropped_degenerate},
+                   {"fins_cancelled", r.fe.n_fins_cancelled},
                    {"repairs", r.n_repairs},
                    {"octants_built", r.n_octants_built},
                    {"smoothing_accepted", r.n_smoothing_accepted},

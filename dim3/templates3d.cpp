@@ -25,6 +25,59 @@ std::vector<std::int32_t> dedupe_ring(const std::vector<std::int32_t>& r) {
   return out;
 }
 
+/// The ring without its spikes (a b a -> a, cyclically) and repeated nodes: the polygon of the
+/// projections where two corners that are not neighbours land on the same surface point and the
+/// corner between them elsewhere (the spike encloses no area).
+std::vector<std::int32_t> despike_ring(std::vector<std::int32_t> r) {
+  r = dedupe_ring(r);
+  for (bool changed = true; changed && r.size() >= 3;) {
+    changed = false;
+    for (std::size_t i = 0; i < r.size() && r.size() >= 3; ++i) {
+      const std::size_t prev = (i + r.size() - 1) % r.size(), next = (i + 1) % r.size();
+      if (r[prev] != r[next]) continue;
+      // prev, i, next = a b a: drop b and the second a.
+      const std::size_t lo = std::min(i, next), hi = std::max(i, next);
+      r.erase(r.begin() + static_cast<std::ptrdiff_t>(hi));
+      r.erase(r.begin() + static_cast<std::ptrdiff_t>(lo));
+      r = dedupe_ring(r);
+      changed = true;
+      break;
+    }
+  }
+  return r.size() >= 3 ? r : std::vector<std::int32_t>{};
+}
+
+/// Removes every triangle whose reverse is also in `tris` (a fin: two faces of one cell back
+/// to back, enclosing nothing). Its two cones would have opposite volumes, one of them inverted,
+/// and no node move can fix that. Such a fin appears where a face corner's neighbours on both
+/// sides project to one surface point and the corner itself elsewhere (measured:
+/// regressions/voxel-notched-cube-fin.off at the notch's concave corner). Without it the cell
+/// pinches there and the two cells beside it meet through the triangle.
+std::size_t cancel_fins(std::vector<Tri>& tris) {
+  const auto canonical = [](Tri t) {
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    return t;
+  };
+  std::vector<std::uint8_t> gone(tris.size(), 0);
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < tris.size(); ++i) {
+    if (gone[i]) continue;
+    const Tri rev = canonical({tris[i][0], tris[i][2], tris[i][1]});
+    for (std::size_t j = i + 1; j < tris.size(); ++j)
+      if (!gone[j] && canonical(tris[j]) == rev) {
+        gone[i] = gone[j] = 1;
+        ++n;
+        break;
+      }
+  }
+  if (n == 0) return 0;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < tris.size(); ++i)
+    if (!gone[i]) tris[k++] = tris[i];
+  tris.resize(k);
+  return n;
+}
+
 /// Smallest angle of triangle abc (radians, 0 when degenerate).
 double min_angle(const P3& a, const P3& b, const P3& c) {
   const auto ang = [](const P3& o, const P3& u, const P3& v) {
@@ -182,7 +235,7 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
       triangulate_quad_by_id({bo.ring[i], bo.ring[j], p[j], p[i]}, tris);
     }
     // Surface face: owned by this cell alone.
-    const std::vector<std::int32_t> pr = dedupe_ring(p);
+    const std::vector<std::int32_t> pr = despike_ring(p);
     std::vector<Tri> ptris;
     if (pr.size() == 3) {
       ptris.push_back({pr[0], pr[1], pr[2]});
@@ -210,8 +263,15 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
       }
       for (std::size_t i = 0; i < pr.size(); ++i) ptris.push_back({centre, pr[i], pr[(i + 1) % pr.size()]});
     }
-    for (const Tri& q : ptris) {
-      if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+    const std::size_t n_side = tris.size();
+    for (const Tri& q : ptris)
+      if (q[0] != q[1] && q[1] != q[2] && q[2] != q[0]) tris.push_back(q);
+    // Surface triangles have no lattice node and side triangles do: a fin is two side triangles
+    // or two surface ones; only the surviving surface triangles are interface elements.
+    std::vector<Tri> surface_tris(tris.begin() + static_cast<std::ptrdiff_t>(n_side), tris.end());
+    tris.resize(n_side);
+    b.out.n_fins_cancelled += cancel_fins(tris) + cancel_fins(surface_tris);
+    for (const Tri& q : surface_tris) {
       tris.push_back(q);
       b.out.mesh.interface.add(ElemType::Tri3, {VertexId{q[0]}, VertexId{q[1]}, VertexId{q[2]}});
     }

@@ -39,6 +39,7 @@ struct TetMesh {
   /// complex.boundary offset by complex.interior.size()).
   std::vector<std::int32_t> cell;
   std::size_t n_dropped_degenerate = 0;  ///< cones with a repeated node (degenerate octants)
+  std::size_t n_fins_cancelled = 0;      ///< pairs of back-to-back triangles of one cell, dropped
 };
 
 /// Node ids 0..complex.points.size()-1 of the result are the complex's nodes.

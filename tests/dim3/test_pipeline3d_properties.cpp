@@ -218,6 +218,12 @@ TEST_CASE("3D pipeline output is valid on tori", "[property][pipeline3d][!mayfai
 // 185 was valid (54154 tets, 11.4 deg, 1 repair) and is refused after it (16 inverted elements
 // after 2 repairs): a regression of the island trial, kept as regressions/mayfail-voxel-island-
 // trial-refused.off.
+// Session 11: the notched cube's inverted tetrahedron was a fin (templates3d cancel_fins: two
+// back-to-back triangles of one boundary octant at the notch's concave corner, where a face
+// corner's two neighbours project to one surface point), now valid on its first tree and kept
+// as regressions/voxel-notched-cube-fin.off; and case 194 (a 4x4x4 union) was accepted with a
+// hanging node where two sheets meet on a concave feature line, now refined around since the
+// pipeline validates before it accepts (regressions/voxel-hanging-node-concave-edge.off).
 TEST_CASE("3D pipeline output is valid on voxel unions", "[property][pipeline3d][!mayfail]") {
   validity_property("voxel unions", 4, test::gen_voxel_spec(), 3, true);
 }
@@ -362,6 +368,19 @@ void check_regression(const fs::path& file) {
 
 TEST_CASE("shrunk 3D property counterexamples mesh validly", "[pipeline3d][regression]") {
   for (const fs::path& f : regression_files(false)) check_regression(f);
+}
+
+TEST_CASE("a fin of a boundary octant is cancelled rather than refined around", "[pipeline3d][regression]") {
+  // The notched cube (7 of 8 cells) at level 3: a face corner's two neighbours project near the
+  // notch's concave corner and the corner itself elsewhere, so two side triangles of the octant
+  // lie back to back; their cones had opposite volumes, one inverted, and every repair failed.
+  const fs::path file = fs::path(FEBEMESH_SOURCE_DIR) / "tests" / "dim3" / "regressions" / "voxel-notched-cube-fin.off";
+  std::ifstream in(file);
+  const Outcome3 out = run_surface(Surface(read_off(in, file.string())), file_level(file));
+  INFO(out.v.summary());
+  CHECK(out.v.valid);
+  CHECK(out.r.fe.n_fins_cancelled > 0);
+  CHECK(out.r.n_repairs == 0);
 }
 
 TEST_CASE("shrunk 3D property counterexamples not fixed yet", "[pipeline3d][regression][!mayfail]") {
