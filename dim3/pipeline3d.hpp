@@ -56,6 +56,12 @@ struct Options3d {
   /// In those sweeps, nodes snapped onto a feature line slide along it (else they stay put).
   bool slide_feature_nodes = true;
   int max_repairs = 12;              ///< local refinements when the construction needs them
+  /// Repairs that may leave more problems than the tree before them: a try stops at the next
+  /// one that does ("the last one made it worse"). Refining around inverted tetrahedra moves
+  /// the folds, so the count is noisy on the way down (fandisk L5's last try: 54 50 49 47 33
+  /// 25 35, then valid). 0 for the tries that have another try after them (their meshes stay
+  /// the same); retry_facing's last try has 1.
+  int worse_repairs = 0;
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).
   int topology_refinements = 2;
