@@ -419,7 +419,8 @@ struct Optimizer {
       const std::int32_t t = incident[k];
       const double q = tet_q[t];
       if (q <= near || (f0 <= 0 && q <= 0)) {
-        const P3 gt = gradient(local[k - start[v]], x0, h);
+        // The worst tetrahedron's gradient is g (the same numbers).
+        const P3 gt = k - start[v] == worst_local ? g : gradient(local[k - start[v]], x0, h);
         if (gt.norm() > 0) sum += gt.normalized();
       }
     }
