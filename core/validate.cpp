@@ -394,7 +394,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   }
 
   // Interface == boundary facets, same orientation.
-  {
+  if (options.check_interface) {
     std::vector<char> matched(boundary.size(), 0);
     for (std::size_t e = 0; e < mesh.interface.size(); ++e) {
       const Facet f = as_facet(mesh.interface, ElemId{static_cast<std::int32_t>(e)});

@@ -26,6 +26,9 @@ template <int Dim> struct ValidateOptions {
   double hanging_rel_tol = 1e-6;
   /// Two nodes closer than duplicate_rel_tol * (bounding-box diagonal) are duplicates.
   double duplicate_rel_tol = 1e-12;
+  /// Whether the interface elements must be the boundary facets of the solid; false for a part
+  /// of a mesh, whose cut facets have none.
+  bool check_interface = true;
   /// How many human-readable problems to keep.
   int max_problems = 20;
   /// Threads for the per-element, per-node and per-edge checks (boundary_distance must then be

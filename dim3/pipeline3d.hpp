@@ -8,7 +8,6 @@
 // the maximum level.
 
 #include <functional>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -132,10 +131,6 @@ struct Result3d {
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
   std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
   HexDominantStats hex;              ///< with opt.hex_dominant
-  /// The validation of fe.mesh against surface_validation(s) on opt.n_threads, as the pipeline
-  /// checked it before accepting it; empty with opt.hex_dominant (the hexahedra are not checked
-  /// before they are made).
-  std::optional<ValidationReport> validation;
   std::vector<StageTime3> times;
 };
 

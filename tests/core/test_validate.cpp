@@ -248,6 +248,25 @@ TEMPLATE_TEST_CASE_SIG("each kept problem has a site: its kind and a node at it"
   CHECK(n_euler == 1);
 }
 
+TEST_CASE("a part of a mesh validates without the interface check", "[validate]") {
+  // Half of a grid's tetrahedra, no interface elements: their cut facets have no interface
+  // element, which only the interface check counts.
+  const Mesh<3> grid = test::grid_mesh<3>(3, true);
+  Mesh<3> part;
+  part.points = grid.points;
+  for (std::size_t e = 0; e < grid.solid.size() / 2; ++e)
+    part.solid.add(ElemType::Tet4, grid.solid.nodes(ElemId{static_cast<std::int32_t>(e)}), 4);
+  ValidateOptions<3> vo;
+  const ValidationReport whole = validate(part, vo);
+  CHECK(whole.interface_missing > 0);
+  vo.check_interface = false;
+  const ValidationReport r = validate(part, vo);
+  INFO(r.summary());
+  CHECK(r.interface_mismatch == 0);
+  CHECK(r.hanging_nodes == 0);
+  CHECK(r.nonconforming_facets == 0);
+}
+
 TEST_CASE("a large grid (82,944 tetrahedra) validates", "[validate]") {
   const Mesh<3> mesh = test::grid_mesh<3>(24, true);  // 82944 tets
   const ValidationReport r = validate(mesh);
