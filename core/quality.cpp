@@ -97,6 +97,36 @@ Point<3> facet_normal(ElemType t, int f, std::span<const Point<3>> p) {
   return 0.5 * n;
 }
 
+/// Gmsh's tetrahedron facets (mesh_topology's table): facet_normal and signed_measure of a Tet4
+/// with the same operations on constant indices (no table look-up per facet; issue 8).
+constexpr int tet_facet_nodes[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {3, 1, 2}};
+
+Point<3> tet_facet_normal(int f, std::span<const Point<3>> p) {
+  const int* l = tet_facet_nodes[f];
+  Point<3> n = Point<3>::Zero();
+  const Point<3>& o = p[l[0]];
+  n += (p[l[1]] - o).cross(p[l[2]] - o);
+  return 0.5 * n;
+}
+
+template <int Dim> double tet_signed_measure(std::span<const Point<Dim>> p) {
+  if constexpr (Dim == 3) {
+    double v = 0.0;
+    for (int f = 0; f < 4; ++f) {
+      const int* l = tet_facet_nodes[f];
+      double w = 0.0;
+      const Point<3> a = p[l[0]] - p[0], b = p[l[1]] - p[0], c = p[l[2]] - p[0];
+      w += a.dot(b.cross(c));
+      v += w;
+    }
+    return v / 6.0;
+  } else {
+    MESH_ASSERT(false, "3D element in a 2D mesh");
+    (void)p;
+    return 0.0;
+  }
+}
+
 bool facet_has_edge(std::span<const int> facet, int a, int b) {
   const std::size_t n = facet.size();
   for (std::size_t i = 0; i < n; ++i) {
@@ -175,32 +205,6 @@ template <int n> std::pair<double, double> polygon_jacobians(std::span<const Poi
   return {m, std::clamp(s * normalise, -1.0, 1.0)};
 }
 
-}  // namespace
-
-template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<Dim>> p) {
-  MESH_ASSERT(static_cast<int>(p.size()) == n_nodes(t), name(t) << " with " << p.size() << " points");
-  if (t == ElemType::Line2) return (p[1] - p[0]).norm();
-  double m = inf;
-  for (const Corner& k : corners(t)) m = std::min(m, corner_jacobian<Dim>(t, k, p).first);
-  return m;
-}
-
-template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>> p) {
-  if constexpr (Dim == 2) {
-    if (t == ElemType::Tri3) return polygon_jacobians<3>(p, normalisation(t)).second;
-    if (t == ElemType::Quad4) return polygon_jacobians<4>(p, normalisation(t)).second;
-  }
-  if (t == ElemType::Line2) return (p[1] - p[0]).norm() > 0.0 ? 1.0 : 0.0;
-  double m = inf;
-  for (const Corner& k : corners(t)) {
-    const auto [jac, lengths] = corner_jacobian<Dim>(t, k, p);
-    m = std::min(m, lengths > 0.0 ? jac / lengths : 0.0);
-  }
-  return std::clamp(m * normalisation(t), -1.0, 1.0);
-}
-
-namespace {
-
 /// jacobians() of a tetrahedron: the corners of tet_corners in their order, with the same
 /// numbers, but each of the six edge lengths computed once (|p - q| and |q - p| are the same
 /// bits), not once per corner that uses it (the smoothing guard's hot path).
@@ -223,6 +227,31 @@ std::pair<double, double> tet_jacobians(std::span<const Point<3>> p) {
 }
 
 }  // namespace
+
+template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<Dim>> p) {
+  MESH_ASSERT(static_cast<int>(p.size()) == n_nodes(t), name(t) << " with " << p.size() << " points");
+  if (t == ElemType::Line2) return (p[1] - p[0]).norm();
+  double m = inf;
+  for (const Corner& k : corners(t)) m = std::min(m, corner_jacobian<Dim>(t, k, p).first);
+  return m;
+}
+
+template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>> p) {
+  if constexpr (Dim == 2) {
+    if (t == ElemType::Tri3) return polygon_jacobians<3>(p, normalisation(t)).second;
+    if (t == ElemType::Quad4) return polygon_jacobians<4>(p, normalisation(t)).second;
+  }
+  if constexpr (Dim == 3) {
+    if (t == ElemType::Tet4) return tet_jacobians(p).second;  // the same numbers, 6 norms, not 12
+  }
+  if (t == ElemType::Line2) return (p[1] - p[0]).norm() > 0.0 ? 1.0 : 0.0;
+  double m = inf;
+  for (const Corner& k : corners(t)) {
+    const auto [jac, lengths] = corner_jacobian<Dim>(t, k, p);
+    m = std::min(m, lengths > 0.0 ? jac / lengths : 0.0);
+  }
+  return std::clamp(m * normalisation(t), -1.0, 1.0);
+}
 
 template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p) {
   if constexpr (Dim == 2) {
@@ -249,6 +278,7 @@ template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>>
     case ElemType::Quad4:
       // Diagonals' cross product: exact for a planar quad, also non-convex ones.
       return 0.5 * cross2<Dim>(p[2] - p[0], p[3] - p[1]);
+    case ElemType::Tet4: return tet_signed_measure<Dim>(p);
     default: break;
   }
   if constexpr (Dim == 3) {
@@ -333,6 +363,157 @@ template <int Dim> std::vector<double> scaled_jacobians(const Elements& els, con
   return out;
 }
 
+namespace {
+
+// summarize_quality's tetrahedra (issue 8: the summary was 11% of sphere966 level 5): every
+// number of element_quality and signed_measure as they compute it, with each facet normal, edge
+// length and the measure computed once, and the dihedral angles kept as their keys (the cosine
+// between the facets' outward normals, 1 for a degenerate facet): the angle is 180 - acos(key)
+// in degrees, non-decreasing in the key, so acos is taken only where an extreme or the sliver
+// test needs it. Keys farther apart than key_gap give acos results in the same order (|acos'| >= 1,
+// and acos is within an ulp), so only the keys within key_gap of an extreme can give that extreme.
+constexpr double key_gap = 1e-9;
+
+double dihedral_of_key(double key) { return 180.0 - std::acos(key) * rad_to_deg; }
+
+struct TetTerms {
+  double scaled_jacobian, aspect_ratio, radius_ratio, measure;
+  std::array<double, 6> key;  ///< per edge, in edge_local_nodes order; NaN ones are ignored
+  double key_lo, key_hi;      ///< extremes of the non-NaN keys (inf, -inf without any)
+};
+
+/// The two facets of each edge of a tetrahedron, as dihedral_range finds them.
+const std::array<std::array<int, 2>, 6>& tet_edge_facets() {
+  static const auto table = [] {
+    std::array<std::array<int, 2>, 6> out{};
+    constexpr ElemType t = ElemType::Tet4;
+    for (int e = 0; e < n_edges(t); ++e) {
+      const auto [a, b] = edge_local_nodes(t, e);
+      int found = 0;
+      for (int f = 0; f < n_facets(t) && found < 2; ++f)
+        if (facet_has_edge(facet_local_nodes(t, f), a, b)) out[e][found++] = f;
+      MESH_ASSERT(found == 2, "edge " << e);
+    }
+    return out;
+  }();
+  return table;
+}
+
+TetTerms tet_terms(std::span<const Point<3>> p) {
+  constexpr ElemType t = ElemType::Tet4;
+  TetTerms r;
+  r.scaled_jacobian = tet_jacobians(p).second;
+  // Longest edge: edge_length_range's maximum (the order of a maximum does not matter).
+  double longest = 0.0;
+  for (int e = 0; e < 6; ++e) {
+    const auto [a, b] = edge_local_nodes(t, e);
+    longest = std::max(longest, (p[b] - p[a]).norm());
+  }
+  Point<3> normal[4];
+  double normal_len[4];
+  double area = 0.0;
+  for (int f = 0; f < 4; ++f) {
+    normal[f] = tet_facet_normal(f, p);
+    normal_len[f] = normal[f].norm();
+    area += normal_len[f];
+  }
+  r.measure = signed_measure<3>(t, p);
+  const double volume = std::abs(r.measure);
+  r.aspect_ratio = volume > 0.0 ? longest * area / (6.0 * std::sqrt(6.0) * volume) : inf;
+  {  // tet_radius_ratio, with its facet area sum shared
+    const Point<3> a = p[1] - p[0], b = p[2] - p[0], c = p[3] - p[0];
+    const double det = a.dot(b.cross(c));
+    if (det <= 0.0) {
+      r.radius_ratio = inf;
+    } else {
+      const Point<3> num = a.squaredNorm() * b.cross(c) + b.squaredNorm() * c.cross(a) + c.squaredNorm() * a.cross(b);
+      const double circum = num.norm() / (2.0 * det);
+      const double in = det / (2.0 * area);
+      r.radius_ratio = circum / (3.0 * in);
+    }
+  }
+  // angle_deg's cosine, clamped; a zero normal gives 0 degrees there, acos(1) here.
+  const auto& pairs = tet_edge_facets();
+  r.key_lo = inf;
+  r.key_hi = -inf;
+  for (int e = 0; e < 6; ++e) {
+    const int f0 = pairs[e][0], f1 = pairs[e][1];
+    const double na = normal_len[f0], nb = normal_len[f1];
+    const double k = na == 0.0 || nb == 0.0 ? 1.0 : std::clamp(normal[f0].dot(normal[f1]) / (na * nb), -1.0, 1.0);
+    r.key[e] = k;
+    if (k < r.key_lo) r.key_lo = k;
+    if (k > r.key_hi) r.key_hi = k;
+  }
+  return r;
+}
+
+/// dihedral_range's minimum (maximum): over the keys within key_gap of the smallest (largest).
+double min_dihedral(const TetTerms& r) {
+  double lo = inf;
+  for (const double k : r.key)
+    if (k <= r.key_lo + key_gap) lo = std::min(lo, dihedral_of_key(k));
+  return lo;
+}
+double max_dihedral(const TetTerms& r) {
+  double hi = -inf;
+  for (const double k : r.key)
+    if (k >= r.key_hi - key_gap) hi = std::max(hi, dihedral_of_key(k));
+  return hi;
+}
+
+/// Summary terms of tetrahedra [begin, end) into p and sum_sj, as the generic loop adds them.
+template <int Dim>
+void summarize_tets(const Mesh<Dim>& mesh, std::size_t begin, std::size_t end, double sliver_threshold_deg,
+                    QualitySummary& p, double& sum_sj) {
+  if constexpr (Dim == 3) {
+    // Sliver test on the smallest key: below key_sliver - 1e-7 the min dihedral is surely under
+    // the threshold, above key_sliver + 1e-7 surely not (1e-7 rad is far above acos's error);
+    // in between it is computed.
+    const double th = sliver_threshold_deg;
+    const bool by_key = th > 0.0 && th < 180.0;
+    const double key_sliver = by_key ? std::cos((180.0 - th) / rad_to_deg) : 0.0;
+    // Running extreme keys of the chunk: an element whose smallest key is above the running
+    // smallest + key_gap cannot hold the chunk's min dihedral (likewise for the max).
+    double run_lo = inf, run_hi = -inf;
+    for (std::size_t e = begin; e < end; ++e) {
+      const auto ep = element_points<3>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+      const TetTerms r = tet_terms(ep.span());
+      p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, r.scaled_jacobian);
+      sum_sj += r.scaled_jacobian;
+      double lo = std::numeric_limits<double>::quiet_NaN();  // NaN: not computed
+      if (r.key_lo <= run_lo + key_gap) {
+        lo = min_dihedral(r);
+        p.min_angle_deg = std::min(p.min_angle_deg, lo);
+        run_lo = std::min(run_lo, r.key_lo);
+      }
+      if (r.key_hi >= run_hi - key_gap) {
+        p.max_angle_deg = std::max(p.max_angle_deg, max_dihedral(r));
+        run_hi = std::max(run_hi, r.key_hi);
+      }
+      p.max_aspect_ratio = std::max(p.max_aspect_ratio, r.aspect_ratio);
+      p.max_radius_ratio = std::max(p.max_radius_ratio, r.radius_ratio);
+      const int bin = std::clamp(static_cast<int>(std::floor((r.scaled_jacobian + 1.0) / 0.2)), 0, 9);
+      ++p.scaled_jacobian_histogram[bin];
+      bool sliver;
+      if (by_key && r.key_lo < key_sliver - 1e-7) {
+        sliver = true;
+      } else if (by_key && r.key_lo > key_sliver + 1e-7) {
+        sliver = false;
+      } else {
+        if (std::isnan(lo)) lo = min_dihedral(r);
+        sliver = lo < sliver_threshold_deg;
+      }
+      if (sliver) ++p.n_slivers;
+      p.measure += r.measure;
+    }
+  } else {
+    (void)mesh, (void)begin, (void)end, (void)sliver_threshold_deg, (void)p, (void)sum_sj;
+    MESH_ASSERT(false, "tetrahedra in a 2D mesh");
+  }
+}
+
+}  // namespace
+
 template <int Dim>
 QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg, int n_threads) {
   QualitySummary s;
@@ -352,6 +533,14 @@ QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_
     p.min_scaled_jacobian = inf;
     p.min_angle_deg = inf;
     p.max_angle_deg = -inf;
+    if constexpr (Dim == 3) {
+      const bool all_tets = std::all_of(mesh.solid.type.begin() + begin, mesh.solid.type.begin() + end,
+                                        [](ElemType t) { return t == ElemType::Tet4; });
+      if (all_tets) {
+        summarize_tets<Dim>(mesh, begin, end, sliver_threshold_deg, p, parts[c].sum_sj);
+        return;
+      }
+    }
     for (std::size_t e = begin; e < end; ++e) {
       const ElemType t = mesh.solid.type[e];
       const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);

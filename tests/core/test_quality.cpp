@@ -2,7 +2,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/quality.hpp"
 #include "test_mesh_fixtures.hpp"
@@ -157,4 +159,31 @@ TEST_CASE("the summary is the same on 1, 2 and 3 threads and sums what its eleme
   CHECK(one.n_slivers == slivers);
   CHECK(slivers > 0);
   CHECK(slivers < sj.size());
+}
+
+TEST_CASE("the tetrahedra's summary equals element_quality's, bit for bit", "[quality]") {
+  // summarize_quality takes acos only near the extremes and the sliver threshold; element_quality
+  // takes it for every dihedral angle (the slow twin).
+  Mesh<3> m = test::grid_mesh<3>(8, true);
+  for (Point<3>& p : m.points) p += 0.2 * Point<3>(std::sin(7.0 * p.y()), std::cos(5.0 * p.z()), std::sin(3.0 * p.x()));
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo, aspect = 0.0, radius = 0.0;
+  std::vector<double> mins;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const auto ep = element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, m.points);
+    const ElementQuality q = element_quality<3>(ElemType::Tet4, ep.span());
+    lo = std::min(lo, q.min_angle_deg), hi = std::max(hi, q.max_angle_deg);
+    aspect = std::max(aspect, q.aspect_ratio), radius = std::max(radius, q.radius_ratio);
+    mins.push_back(q.min_angle_deg);
+  }
+  std::sort(mins.begin(), mins.end());
+  // Thresholds at elements' own min dihedral angles (the strict "<" at its edge) and between.
+  for (const double th : {10.0, 40.0, mins[mins.size() / 3], mins[mins.size() / 2], std::nextafter(mins[7], 0.0), 179.0}) {
+    const QualitySummary s = summarize_quality(m, th);
+    CAPTURE(th);
+    CHECK(s.min_angle_deg == lo);
+    CHECK(s.max_angle_deg == hi);
+    CHECK(s.max_aspect_ratio == aspect);
+    CHECK(s.max_radius_ratio == radius);
+    CHECK(s.n_slivers == static_cast<std::size_t>(std::lower_bound(mins.begin(), mins.end(), th) - mins.begin()));
+  }
 }
