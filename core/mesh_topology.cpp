@@ -429,8 +429,11 @@ std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
   return sorted;
 }
 
-void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
-                               std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed) {
+namespace {
+
+/// append_polygon_neighbours for any polygons (v may appear more than once in one).
+void append_polygon_neighbours_any(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
+                                   std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed) {
   const std::size_t begin = out.size();
   for (const std::int32_t e : elems) {
     const ElemId id{e};
@@ -446,6 +449,54 @@ void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<co
     listed[out[i]] = 0;
     for (std::size_t j = i; j > begin && out[j] < out[j - 1]; --j) std::swap(out[j], out[j - 1]);
   }
+}
+
+}  // namespace
+
+// Cost: v is once in each of its polygons in a valid mesh, so each gives two neighbours, written
+// through a pointer into room made once (push_back and the modulo per corner were most of the
+// 2D quality pass's neighbour gathering, ~590 instructions a node at flange level 9); the rare
+// polygon that holds v twice sends the node to the general version.
+void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
+                               std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed) {
+  const std::size_t begin = out.size();
+  out.resize(begin + 2 * elems.size());
+  std::int32_t* const first = out.data() + begin;
+  std::int32_t* last = first;
+  for (const std::int32_t e : elems) {
+    const std::int32_t o = els.offset[static_cast<std::size_t>(e)];
+    const int n = els.offset[static_cast<std::size_t>(e) + 1] - o;
+    const VertexId* ev = els.node.data() + o;
+    std::int32_t next, prev;
+    bool twice;
+    if (n == 3) {  // the common case, unrolled
+      const std::int32_t a = ev[0].v, b = ev[1].v, c = ev[2].v;
+      if (a == v) next = b, prev = c, twice = b == v || c == v;
+      else if (b == v) next = c, prev = a, twice = c == v;
+      else if (c == v) next = a, prev = b, twice = false;
+      else continue;
+    } else {
+      int at = -1, hits = 0;
+      for (int k = 0; k < n; ++k)
+        if (ev[k].v == v) at = k, ++hits;
+      if (hits == 0) continue;
+      next = ev[at + 1 == n ? 0 : at + 1].v, prev = ev[at == 0 ? n - 1 : at - 1].v, twice = hits > 1;
+    }
+    if (twice) [[unlikely]] {
+      for (const std::int32_t* w = first; w != last; ++w) listed[*w] = 0;
+      out.resize(begin);
+      append_polygon_neighbours_any(els, v, elems, out, listed);
+      return;
+    }
+    if (!listed[next]) listed[next] = 1, *last++ = next;
+    if (!listed[prev]) listed[prev] = 1, *last++ = prev;
+  }
+  const auto count = static_cast<std::size_t>(last - first);
+  for (std::size_t i = 0; i < count; ++i) {
+    listed[first[i]] = 0;
+    for (std::size_t j = i; j > 0 && first[j] < first[j - 1]; --j) std::swap(first[j], first[j - 1]);
+  }
+  out.resize(begin + count);
 }
 
 std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els) {
