@@ -554,8 +554,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     Flags in;
     OctantComplexResult oc;
     TetMesh fe;
+    bool topology_right = true;  ///< false: its Euler characteristic is wrong (not a valid mesh)
   };
-  std::optional<Saved> saved;  // the last valid mesh whose topology a refinement tries to fix
+  std::optional<Saved> saved;  // the last mesh whose topology or islands a refinement tries to fix
   // The valid coarser mesh in `saved` stands (with its volume warning) when the finer tree's
   // cannot be built.
   const auto restore_saved = [&]() {
@@ -856,7 +857,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
                                     std::to_string(s.euler_characteristic() / 2)
                               : std::to_string(r.n_islands_dropped) + " octants in islands") +
               ")");
-          saved = Saved{r, tree, in, oc, std::move(fe)};
+          saved = Saved{r, tree, in, oc, std::move(fe), !topology_wrong};
           n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
           tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
           clock.lap("repair refinement");
@@ -915,9 +916,12 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     std::vector<P3> places;
     for (const Problem3& pr : problems) places.push_back(pr.where);
     const bool stuck = last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags);
-    if (stuck && saved) {
+    if (stuck && saved && saved->topology_right) {
       // The finer tree could not be built: the valid coarser mesh stands (with its volume
-      // warning), rather than no mesh.
+      // warning), rather than no mesh. Not one with the wrong Euler characteristic: the run
+      // is refused instead, so that the next try (without feature snapping, ...) runs
+      // (measured: regressions/torus-seed12-case195-euler.off, a 24x14 torus at level
+      // 3, returned its first mesh with Euler characteristic 1 instead of 0).
       say("repair " + std::to_string(attempt + 1) + ": the refined tree has " + std::to_string(problems.size()) +
           " problem(s) (" + describe(problems) + "); keeping the mesh before the refinement");
       return restore_saved();

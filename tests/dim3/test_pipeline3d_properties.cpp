@@ -201,6 +201,10 @@ TEST_CASE("3D pipeline output is valid on coarse perturbed spheres", "[property]
 // (regressions/torus-12x8-topology-refinement-folds.off), so still [!mayfail]. Session 9: that
 // case is valid since the thickness retry (its first mesh loses more than 5%; CLI: valid, 7968
 // tets, 19.6 deg, 7.66% lost), and moves to the regressions that must pass.
+// Session 11 (survey, 200 cases each): seed 11 all valid; seed 12 case 195 (24x14, level 3)
+// returned the mesh saved before a failed topology refinement, Euler 1 instead of 0; such a
+// mesh is no longer restored (regressions/torus-seed12-case195-euler.off). Still [!mayfail]
+// until a longer survey runs clean.
 TEST_CASE("3D pipeline output is valid on tori", "[property][pipeline3d][!mayfail]") {
   validity_property("tori", 4, test::gen_torus_spec(), 3, true);
 }
