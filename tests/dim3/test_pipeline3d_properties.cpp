@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -376,7 +377,13 @@ void check_regression(const fs::path& file) {
 }  // namespace
 
 TEST_CASE("shrunk 3D property counterexamples mesh validly", "[pipeline3d][regression]") {
-  for (const fs::path& f : regression_files(false)) check_regression(f);
+  // Under the sanitizers the ones that take 9-16 s CPU in Release (CLI, one thread: torus-seed12
+  // 15.6, voxel-hanging-node 12.0, voxel-island-trial 9.6) are left to the Release suite: with
+  // them the sanitizer suite's dim3 test took 609 s instead of about 200.
+  const std::set<std::string> slow = {"torus-seed12-case195-euler.off", "voxel-hanging-node-concave-edge.off",
+                                      "voxel-island-trial.off"};
+  for (const fs::path& f : regression_files(false))
+    if (!(test::sanitized() && slow.count(f.filename().string()))) check_regression(f);
 }
 
 TEST_CASE("a fin of a boundary octant is cancelled rather than refined around", "[pipeline3d][regression]") {
