@@ -57,6 +57,28 @@ void array(Text& out, const char* type, const char* name, int components, std::s
   out << "        </DataArray>\n";
 }
 
+/// The solid elements at each node with a slot (slot[v] >= 0; nodes with negative ids have
+/// none), as CSR: slot s's are elem[start[s] .. start[s + 1]), in element order, an element
+/// once per use of the node.
+void elements_at_slots(const Elements& solid, const std::vector<std::int32_t>& slot, std::int32_t n_slots,
+                       std::vector<std::int32_t>& start, std::vector<std::int32_t>& elem) {
+  const auto slot_of = [&](VertexId v) { return v.v >= 0 ? slot[static_cast<std::size_t>(v.v)] : -1; };
+  start.assign(static_cast<std::size_t>(n_slots) + 1, 0);
+  for (std::size_t e = 0; e < solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int k = 0; k < solid.n_nodes_of(id); ++k)
+      if (const std::int32_t s = slot_of(solid.nodes(id)[k]); s >= 0) ++start[s + 1];
+  }
+  for (std::int32_t i = 0; i < n_slots; ++i) start[i + 1] += start[i];
+  elem.resize(start.back());
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t e = 0; e < solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    for (int k = 0; k < solid.n_nodes_of(id); ++k)
+      if (const std::int32_t s = slot_of(solid.nodes(id)[k]); s >= 0) elem[fill[s]++] = id.v;
+  }
+}
+
 /// The element whose facet interface element e is, for every e: the one solid element that uses
 /// that facet, or -1 when none or several do (then it is not a boundary facet).
 template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& mesh) {
@@ -83,21 +105,7 @@ template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& m
         std::int32_t& s = slot[static_cast<std::size_t>(k.v[0])];
         if (s < 0) s = n_slots++;
       }
-      start.assign(static_cast<std::size_t>(n_slots) + 1, 0);
-      auto slot_of = [&](VertexId v) { return v.v >= 0 ? slot[static_cast<std::size_t>(v.v)] : -1; };
-      for (std::size_t e = 0; e < solid.size(); ++e) {
-        const ElemId id{static_cast<std::int32_t>(e)};
-        for (int k = 0; k < solid.n_nodes_of(id); ++k)
-          if (const std::int32_t s = slot_of(solid.nodes(id)[k]); s >= 0) ++start[s + 1];
-      }
-      for (std::int32_t i = 0; i < n_slots; ++i) start[i + 1] += start[i];
-      elem.resize(start.back());
-      std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
-      for (std::size_t e = 0; e < solid.size(); ++e) {
-        const ElemId id{static_cast<std::int32_t>(e)};
-        for (int k = 0; k < solid.n_nodes_of(id); ++k)
-          if (const std::int32_t s = slot_of(solid.nodes(id)[k]); s >= 0) elem[fill[s]++] = id.v;
-      }
+      elements_at_slots(solid, slot, n_slots, start, elem);
       for (std::size_t e = 0; e < inter.size(); ++e) {
         const std::int32_t s = slot[static_cast<std::size_t>(keys[e].v[0])];
         int uses = 0;
@@ -138,20 +146,7 @@ template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& m
     std::int32_t& s = slot[std::min(v[0].v, v[1].v)];
     if (s < 0) s = n_slots++;
   }
-  start.assign(static_cast<std::size_t>(n_slots) + 1, 0);
-  for (std::size_t e = 0; e < solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int k = 0; k < solid.n_nodes_of(id); ++k)
-      if (const std::int32_t s = slot[solid.nodes(id)[k].v]; s >= 0) ++start[s + 1];
-  }
-  for (std::int32_t i = 0; i < n_slots; ++i) start[i + 1] += start[i];
-  elem.resize(start.back());
-  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
-  for (std::size_t e = 0; e < solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int k = 0; k < solid.n_nodes_of(id); ++k)
-      if (const std::int32_t s = slot[solid.nodes(id)[k].v]; s >= 0) elem[fill[s]++] = id.v;
-  }
+  elements_at_slots(solid, slot, n_slots, start, elem);
   for (std::size_t e = 0; e < inter.size(); ++e) {
     const VertexId* v = inter.nodes(ElemId{static_cast<std::int32_t>(e)});
     const std::int32_t lo = std::min(v[0].v, v[1].v), hi = std::max(v[0].v, v[1].v), s = slot[lo];
