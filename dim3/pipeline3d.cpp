@@ -422,6 +422,13 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   // Measured (fandisk L4, diagnose3d): valid after 3 repairs, 131238 tets, 11.8 deg, 1.6%. Only
   // after the other tries, so that the meshes they make stay bit for bit the same (anchor L5 is
   // refused with these projection rules and the buffer).
+  const Options3d facing = facing_try_options(opt);
+  return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
+}
+
+}  // namespace
+
+Options3d facing_try_options(const Options3d& opt) {
   Options3d facing = opt;
   facing.buffer = 0.0;
   facing.min_outward = 0.3;
@@ -433,8 +440,10 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   // Measured (CLI, one thread): fandisk L5 refused -> valid (the 7th repair of its first
   // sub-try, after 25 -> 35 problems at the 6th).
   facing.worse_repairs = std::max(opt.worse_repairs, 1);
-  return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
+  return facing;
 }
+
+namespace {
 
 /// |volume of the solid elements - the surface's| / the surface's.
 double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {

@@ -143,6 +143,11 @@ using Progress3 = std::function<void(const std::string&)>;
 /// fail, those without the buffer once more with facing projections (Options3d::retry_facing).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
+/// The options of mesh3d's last try when every other fails (Options3d::retry_facing): `opt`
+/// without the buffer rule, with facing projections only, accept_valid_folds, one repair that
+/// makes things worse allowed, and no further retry.
+Options3d facing_try_options(const Options3d& opt);
+
 /// What a mesh of `s` is validated against (DESIGN.md, "Validity"): the solid's Euler
 /// characteristic is half the surface's (when that is even), and interface nodes lie on the
 /// surface within 1e-10 of its diagonal. The options refer to `s`, which must outlive them.

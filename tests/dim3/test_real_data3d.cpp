@@ -153,13 +153,7 @@ TEST_CASE("mesh3d data: fandisk level 5 (valid in the facing try after a repair 
   // error, 96 s CPU; this case alone 52 s CPU).
   Options3d opt;
   opt.level = 5;
-  opt.buffer = 0.0;
-  opt.min_outward = 0.3;
-  opt.min_facing = 0.3;
-  opt.outward_all_faces = true;
-  opt.accept_valid_folds = true;
-  opt.retry_facing = false;
-  opt.worse_repairs = 1;
+  opt = facing_try_options(opt);
   const DataRun d = mesh_and_validate("fandisk", opt);
   CHECK(d.min_dihedral_deg >= 10.0);
   CHECK(d.volume_rel_error < 0.01);
