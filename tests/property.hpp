@@ -22,16 +22,13 @@ inline bool property_cases_given() {
 }
 
 /// Runs `testable` as a rapidcheck property in a Catch2 section. In the CI budget (no case
-/// count given) it tries `ci_cases` cases (1 under the sanitizers, where each is 5-10x slower),
-/// and shrinks a failure only with `shrink_in_ci` (off for properties known to fail, whose
-/// shrinking would take dozens of pipeline runs).
+/// count given) it tries `ci_cases` cases (1 under the sanitizers, where each is 5-10x slower).
 template <typename Testable>
-void prop(const std::string& description, int ci_cases, Testable&& testable, bool shrink_in_ci = true) {
+void prop(const std::string& description, int ci_cases, Testable&& testable) {
   SECTION(description) {
     rc::detail::TestParams params = rc::detail::configuration().testParams;
     if (!property_cases_given()) {
       params.maxSuccess = sanitized() ? std::min(ci_cases, 1) : ci_cases;
-      if (!shrink_in_ci) params.disableShrinking = true;
     }
     rc::detail::TestMetadata metadata;
     metadata.id = description;
