@@ -295,7 +295,12 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // Flips are tried only on edges of elements below `good` degrees: the interior templates have
   // 45 degrees already, so flipping costs little beyond the boundary layer.
   const double good = 44.0, good_cot = 1.0 / std::tan(good * M_PI / 180.0);
+  // A cotangent in [0, good_cot - 1e-6) is good without exceeds(): there its upper bound is
+  // below -4e-7 (hi2 = good_cot^2), far past the slack, so exceeds() says false too. Most
+  // triangles are (the candidate scan asks of every triangle in every flip pass).
+  const double clearly_good_cot = good_cot - 1e-6;
   auto is_good = [&](std::size_t e) {  // exact(e) >= good
+    if (cot[e] >= 0.0 && cot[e] < clearly_good_cot) return true;
     return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact(e); }, 0.0);
   };
   std::vector<EdgeKey> candidates;
