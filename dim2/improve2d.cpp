@@ -179,11 +179,12 @@ class LiveIncidence {
     for (std::size_t e = 0; e < m.solid.size(); ++e)
       for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k) add(m.solid.node[k].v, static_cast<std::int32_t>(e));
   }
+  /// A list is a prefix of its slots (add fills the first free one, remove moves the last in):
+  /// its end is found from the back, where most lists have their spare slots free.
   std::span<const std::int32_t> of(std::int32_t v) const {
     const std::int32_t* list = elem_.data() + first_[v];
-    std::size_t n = 0;
-    const auto room = static_cast<std::size_t>(first_[v + 1] - first_[v]);
-    while (n < room && list[n] >= 0) ++n;
+    auto n = static_cast<std::size_t>(first_[v + 1] - first_[v]);
+    while (n > 0 && list[n - 1] < 0) --n;
     return {list, n};
   }
   /// False (and nothing changed) when v's list is full.
@@ -265,6 +266,25 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   std::vector<double> cot(m.solid.size());
   for (std::size_t e = 0; e < m.solid.size(); ++e) cot[e] = element_top_cot(m, e);
   auto exact = [&](std::size_t e) { return element_min_angle(m, e); };
+  // The exact degrees of elements as they stand (not at a trial position), remembered in a
+  // direct-mapped table by element id and forgotten where cot changes: a node whose elements
+  // tie in cotangent asks for all their degrees, and its neighbours, visited next, ask for
+  // most of the same (flange level 9: most of the atan2 calls of this stage).
+  constexpr std::size_t n_memo = 4096;
+  std::vector<std::int32_t> memo_elem(n_memo, -1);
+  std::vector<double> memo_deg(n_memo);
+  auto exact_now = [&](std::size_t e) {
+    const std::size_t slot = e & (n_memo - 1);
+    if (memo_elem[slot] != static_cast<std::int32_t>(e)) {
+      memo_deg[slot] = exact(e);
+      memo_elem[slot] = static_cast<std::int32_t>(e);
+    }
+    return memo_deg[slot];
+  };
+  auto forget = [&](std::int32_t e) {
+    std::int32_t& held = memo_elem[static_cast<std::size_t>(e) & (n_memo - 1)];
+    if (held == e) held = -1;
+  };
   // The smallest degrees over the mesh: only elements within rounding of the largest
   // cotangent (or without a finite one) can hold it.
   auto mesh_min = [&] {
@@ -301,7 +321,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   const double clearly_good_cot = good_cot - 1e-6;
   auto is_good = [&](std::size_t e) {  // exact(e) >= good
     if (cot[e] >= 0.0 && cot[e] < clearly_good_cot) return true;
-    return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact(e); }, 0.0);
+    return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact_now(e); }, 0.0);
   };
   std::vector<EdgeKey> candidates;
   LiveIncidence incident(m);
@@ -380,6 +400,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
         cot[e0] = tc[2];
         cot[e1] = tc[3];
+        forget(e0), forget(e1);
         flipped.push_back({e0, e1, a, b, c, d});
         ++flips;
       }
@@ -435,9 +456,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
           m.points[v] = saved;
           if (tie || !all_finite) {
             old_deg = 180.0;
-            for (const std::int32_t e : elems) old_deg = std::min(old_deg, exact(static_cast<std::size_t>(e)));
+            for (const std::int32_t e : elems) old_deg = std::min(old_deg, exact_now(static_cast<std::size_t>(e)));
           } else {
-            old_deg = exact(static_cast<std::size_t>(elems[worst]));
+            old_deg = exact_now(static_cast<std::size_t>(elems[worst]));
           }
           m.points[v] = tried;
         }
@@ -474,6 +495,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         ++st.moves;
         for (std::size_t k = 0; k < elems.size(); ++k) {
           cot[elems[k]] = trial_cot[k];  // the accepted trial's
+          forget(elems[k]);
           const ElemId id{elems[k]};
           const VertexId* ev = m.solid.nodes(id);
           for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
