@@ -459,9 +459,14 @@ void append_polygon_neighbours_any(const Elements& els, std::int32_t v, std::spa
 // polygon that holds v twice sends the node to the general version.
 void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<const std::int32_t> elems,
                                std::vector<std::int32_t>& out, std::vector<std::uint8_t>& listed) {
+  // Gathered on the stack for up to 32 polygons (the vector's resize zero-filled the room, a
+  // memset call per node), else in `out` itself.
+  constexpr std::size_t on_stack = 32;
+  std::int32_t stack[2 * on_stack];
   const std::size_t begin = out.size();
-  out.resize(begin + 2 * elems.size());
-  std::int32_t* const first = out.data() + begin;
+  const bool small = elems.size() <= on_stack;
+  if (!small) out.resize(begin + 2 * elems.size());
+  std::int32_t* const first = small ? stack : out.data() + begin;
   std::int32_t* last = first;
   for (const std::int32_t e : elems) {
     const std::int32_t o = els.offset[static_cast<std::size_t>(e)];
@@ -496,7 +501,8 @@ void append_polygon_neighbours(const Elements& els, std::int32_t v, std::span<co
     listed[first[i]] = 0;
     for (std::size_t j = i; j > 0 && first[j] < first[j - 1]; --j) std::swap(first[j], first[j - 1]);
   }
-  out.resize(begin + count);
+  if (small) out.insert(out.end(), first, last);
+  else out.resize(begin + count);
 }
 
 std::vector<std::array<VertexId, 2>> unique_edges_ref(const Elements& els) {

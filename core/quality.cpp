@@ -184,27 +184,6 @@ template <int Dim> double tet_radius_ratio(std::span<const Point<Dim>> p) {
   }
 }
 
-/// jacobians() of a triangle (n = 3) or quadrilateral (n = 4) in the plane: corner i spans
-/// edges e[i] = p[i+1] - p[i] and -e[i-1], so each edge length is taken once and reused (a
-/// vector and its negation have the same norm, bit for bit); the same numbers as the corner loop.
-template <int n> std::pair<double, double> polygon_jacobians(std::span<const Point<2>> p, double normalise) {
-  Point<2> e[n];
-  double len[n];
-  for (int i = 0; i < n; ++i) {
-    e[i] = p[(i + 1) % n] - p[i];
-    len[i] = e[i].norm();
-  }
-  double m = inf, s = inf;
-  for (int i = 0; i < n; ++i) {
-    const int prev = (i + n - 1) % n;
-    const Point<2> a = e[i], b = -e[prev];
-    const double jac = cross2<2>(a, b), lengths = len[i] * len[prev];
-    m = std::min(m, jac);
-    s = std::min(s, lengths > 0.0 ? jac / lengths : 0.0);
-  }
-  return {m, std::clamp(s * normalise, -1.0, 1.0)};
-}
-
 /// jacobians() of a tetrahedron: the corners of tet_corners in their order, with the same
 /// numbers, but each of the six edge lengths computed once (|p - q| and |q - p| are the same
 /// bits), not once per corner that uses it (the smoothing guard's hot path).
@@ -238,8 +217,8 @@ template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<
 
 template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>> p) {
   if constexpr (Dim == 2) {
-    if (t == ElemType::Tri3) return polygon_jacobians<3>(p, normalisation(t)).second;
-    if (t == ElemType::Quad4) return polygon_jacobians<4>(p, normalisation(t)).second;
+    if (t == ElemType::Tri3) return polygon_jacobians<3>(p.data(), normalisation(t)).second;
+    if (t == ElemType::Quad4) return polygon_jacobians<4>(p.data(), normalisation(t)).second;
   }
   if constexpr (Dim == 3) {
     if (t == ElemType::Tet4) return tet_jacobians(p).second;  // the same numbers, 6 norms, not 12
@@ -255,8 +234,8 @@ template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>
 
 template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p) {
   if constexpr (Dim == 2) {
-    if (t == ElemType::Tri3) return polygon_jacobians<3>(p, normalisation(t));
-    if (t == ElemType::Quad4) return polygon_jacobians<4>(p, normalisation(t));
+    if (t == ElemType::Tri3) return polygon_jacobians<3>(p.data(), normalisation(t));
+    if (t == ElemType::Quad4) return polygon_jacobians<4>(p.data(), normalisation(t));
   }
   if (t == ElemType::Line2) return {min_corner_jacobian<Dim>(t, p), scaled_jacobian<Dim>(t, p)};
   if constexpr (Dim == 3) {

@@ -5,8 +5,10 @@
 // measured unsigned, a full-dimensional element signed (positive = counter-clockwise / positive
 // volume with Gmsh's node order).
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -32,6 +34,28 @@ template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>
 /// Both at once, {min_corner_jacobian, scaled_jacobian} (the same values; one pass over the
 /// corners, for the smoothing guard that needs both per trial move).
 template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p);
+/// jacobians() of a triangle (n = 3) or quadrilateral (n = 4) in the plane, with `normalise`
+/// 2/sqrt(3) or 1: corner i spans edges e[i] = p[i+1] - p[i] and -e[i-1], so each edge length is
+/// taken once and reused (a vector and its negation have the same norm, bit for bit); the same
+/// numbers as the corner loop. Inline for the 2D smoothing guard, its hot path.
+template <int n> std::pair<double, double> polygon_jacobians(const Point<2>* p, double normalise) {
+  static_assert(n == 3 || n == 4);
+  Point<2> e[n];
+  double len[n];
+  for (int i = 0; i < n; ++i) {
+    e[i] = p[(i + 1) % n] - p[i];
+    len[i] = e[i].norm();
+  }
+  double m = std::numeric_limits<double>::infinity(), s = m;
+  for (int i = 0; i < n; ++i) {
+    const int prev = (i + n - 1) % n;
+    const Point<2> a = e[i], b = -e[prev];
+    const double jac = a.x() * b.y() - a.y() * b.x(), lengths = len[i] * len[prev];
+    m = std::min(m, jac);
+    s = std::min(s, lengths > 0.0 ? jac / lengths : 0.0);
+  }
+  return {m, std::clamp(s * normalise, -1.0, 1.0)};
+}
 /// Signed length / area / volume (unsigned for an element of lower dimension than Dim).
 template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>> p);
 template <int Dim> ElementQuality element_quality(ElemType t, std::span<const Point<Dim>> p);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 
 #include "core/error.hpp"
@@ -136,6 +137,19 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
         const std::array<Point<3>, 4> p = {mesh.points[v[0].v], mesh.points[v[1].v], mesh.points[v[2].v],
                                            mesh.points[v[3].v]};
         const auto [jac, scaled] = jacobians<3>(type, std::span<const Point<3>>(p.data(), 4));
+        return std::pair{jac > 0.0, scaled};
+      }
+    } else {
+      // Likewise for triangles and quads, inline (jacobians' normalisations: 2/sqrt(3), 1).
+      const VertexId* v = mesh.solid.nodes(ElemId{e});
+      if (type == ElemType::Tri3) {
+        const Point<2> p[3] = {mesh.points[v[0].v], mesh.points[v[1].v], mesh.points[v[2].v]};
+        const auto [jac, scaled] = polygon_jacobians<3>(p, 2.0 / std::sqrt(3.0));
+        return std::pair{jac > 0.0, scaled};
+      }
+      if (type == ElemType::Quad4) {
+        const Point<2> p[4] = {mesh.points[v[0].v], mesh.points[v[1].v], mesh.points[v[2].v], mesh.points[v[3].v]};
+        const auto [jac, scaled] = polygon_jacobians<4>(p, 1.0);
         return std::pair{jac > 0.0, scaled};
       }
     }

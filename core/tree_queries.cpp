@@ -171,20 +171,28 @@ void box_leaves(const Orthtree<Dim>& t, const Cell<Dim>& c, std::size_t lo, std:
     return;
   }
   if (c.level >= max_level<Dim>) return;
-  // Children's leaves are contiguous sub-ranges of [lo, hi) split at the children's keys.
-  std::size_t begin = lo;
+  // Children's leaves are contiguous sub-ranges of [lo, hi) split at the children's keys; the
+  // split is searched for only around the children that meet the box (a small box meets one
+  // or two of them: the searches, a Morton key per probe, were most of this query's cost).
+  const auto& L = t.leaves();
+  auto first_at_or_after = [&](std::size_t from, const Cell<Dim>& cell) {
+    return std::size_t(std::lower_bound(L.begin() + std::ptrdiff_t(from), L.begin() + std::ptrdiff_t(hi), morton_key(cell),
+                                        [](const Cell<Dim>& x, std::uint64_t k) { return morton_key(x) < k; }) -
+                       L.begin());
+  };
+  std::size_t begin = lo;  // child i's first leaf when `known`, else a lower bound of it
+  bool known = true;
   for (int i = 0; i < Cube<Dim>::n_children; ++i) {
     const Cell<Dim> ch = child(c, i);
-    std::size_t end = hi;
-    if (i + 1 < Cube<Dim>::n_children) {
-      const std::uint64_t next = morton_key(child(c, i + 1));
-      const auto& L = t.leaves();
-      end = std::size_t(std::lower_bound(L.begin() + std::ptrdiff_t(begin), L.begin() + std::ptrdiff_t(hi), next,
-                                         [](const Cell<Dim>& x, std::uint64_t k) { return morton_key(x) < k; }) -
-                        L.begin());
+    if (!geometry(t, ch).overlaps(b)) {
+      known = false;
+      continue;
     }
+    if (!known) begin = first_at_or_after(begin, ch);
+    const std::size_t end = i + 1 < Cube<Dim>::n_children ? first_at_or_after(begin, child(c, i + 1)) : hi;
     box_leaves(t, ch, begin, end, b, out);
     begin = end;
+    known = true;
   }
 }
 

@@ -79,19 +79,12 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
     }
   }
-  // Edge neighbours of each node from its incident elements (append_polygon_neighbours).
-  std::vector<std::int32_t> nbr_first(n_nodes + 1, 0), nbr;
+  // Edge neighbours of a node from its incident elements (append_polygon_neighbours), gathered
+  // when the node is searched from: the connectivity does not change here, and most nodes are
+  // above the target and never searched (flange level 9: the lists of all nodes up front were
+  // 80M instructions and 4 bytes per node at this stage's memory peak).
+  std::vector<std::int32_t> nbr;
   std::vector<std::uint8_t> listed(n_nodes, 0);
-  // A node has as many edge neighbours as elements, one more on the boundary (a manifold
-  // mesh): reserving only the elements' count made the last push_back double the array, 8 MB
-  // with the old 4 MB still held, this run's memory peak (flange level 9, massif).
-  nbr.reserve(static_cast<std::size_t>(first.back()) + n_nodes);
-  for (std::size_t v = 0; v < n_nodes; ++v) {
-    append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v),
-                              std::span<const std::int32_t>(incident.data() + first[v], incident.data() + first[v + 1]), nbr,
-                              listed);
-    nbr_first[v + 1] = static_cast<std::int32_t>(nbr.size());
-  }
 
   // Triangles measured against their own aim (q x target / triangle_target); 1 exactly when
   // there is none, so that one-kind meshes see angle_quality itself.
@@ -206,13 +199,17 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
       auto place = [&](const P2& p) { return lock == 2 ? slide(static_cast<std::int32_t>(v), p) : p; };
       const bool bound_chords = lock == 2 && !chord_nbr.first.empty();
       const double chord_limit = bound_chords ? chord_deviation(v, start) : 0.0;
+      nbr.clear();
+      append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v),
+                                std::span<const std::int32_t>(incident.data() + first[v], incident.data() + first[v + 1]),
+                                nbr, listed);
       P2 best = start, centroid = P2::Zero();
       double h = 0.0;
-      for (std::int32_t k = nbr_first[v]; k < nbr_first[v + 1]; ++k) {
-        centroid += m.points[nbr[k]];
-        h += (m.points[nbr[k]] - start).norm();
+      for (const std::int32_t w : nbr) {
+        centroid += m.points[w];
+        h += (m.points[w] - start).norm();
       }
-      const double n_nbr = nbr_first[v + 1] - nbr_first[v];
+      const double n_nbr = static_cast<double>(nbr.size());
       centroid /= n_nbr;
       h /= n_nbr;
       auto consider = [&](const P2& target) {
