@@ -580,16 +580,25 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     return std::move(r);
   };
   int island_refinements = 0;
-  // An island refinement above island_max_fraction is tried once: kept when the volume of the
-  // octants dropped as islands shrinks (the thin part is resolved: tori at level 3, whose whole
-  // tube is two octants thick), else the tree before it comes back (rotor's blades multiply
-  // their islands). Its tries count as island refinements for the repair budget.
+  // An island refinement above island_max_fraction is tried once: kept when no island is left
+  // (the thin part is resolved: tori at level 3, whose whole tube is two octants thick, and
+  // regressions/voxel-island-trial.off go to 0 islands), else the tree before it comes back
+  // (rotor's blades multiply their islands: L4 82 -> 1164). Fewer islands, or less of their
+  // volume, is not enough: finer islands have less volume though the part is no better
+  // resolved, and where islands remain the refined parts are sheets of interior octants one
+  // octant thick whose boundary octants fold (rotor L5, blades 1.2 level-6 octants thick:
+  // 1125 -> 1167 islands, volume 0.00497 -> 0.00064, then 25k raw inverted tets and ~2200
+  // problems per repair; without the buffer rule 1241 -> 419 islands, volume 0.0055 ->
+  // 0.00023, then 1570 problems; the run was refused by the work bound after 7.3 CPU
+  // minutes). Its tries count as island refinements for the repair budget.
   struct IslandTrial {
     Orthtree<3> tree;  ///< before the refinement
     double island_volume = 0.0;
+    std::size_t n_islands = 0;
   };
   std::optional<IslandTrial> island_trial;
   bool island_trial_done = false;
+  bool island_trial_reverted = false;  // the trial did not resolve the thin parts
   int trial_attempts = 0;  // attempts spent on a reverted trial
   for (int attempt = 0;; ++attempt) {
     const bool last = attempt - island_refinements - trial_attempts >= opt.max_repairs;
@@ -602,12 +611,16 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     const Flags before_islands = in;
     r.n_islands_dropped = keep_largest_components(tree, in, s.n_components());
     if (island_trial) {
-      const bool kept = island_volume(tree, before_islands, in) < island_trial->island_volume;
+      const double volume_after = island_volume(tree, before_islands, in);
+      const bool kept = r.n_islands_dropped == 0;
       say("interior octants: " + std::to_string(r.n_islands_dropped) + " in islands after the refinement above " +
-          "the share limit; " + (kept ? "keeping it" : "going back to the tree before it"));
+          "the share limit (" + std::to_string(island_trial->n_islands) + " before; their volume " +
+          std::to_string(volume_after) + ", " + std::to_string(island_trial->island_volume) + " before); " +
+          (kept ? "keeping it" : "going back to the tree before it"));
       if (!kept) {
         tree = std::move(island_trial->tree);
         island_trial.reset();
+        island_trial_reverted = true;
         --island_refinements;  // the trial and this attempt count as trial_attempts instead
         trial_attempts += 2;
         continue;
@@ -646,7 +659,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       const bool over_share = n_marked > opt.island_max_fraction * tree.n_leaves();
       if (marked && over_share && !island_trial_done) {
         island_trial_done = true;
-        island_trial = IslandTrial{tree, island_volume(tree, before_islands, in)};
+        island_trial = IslandTrial{tree, island_volume(tree, before_islands, in), r.n_islands_dropped};
       }
       if (marked && (!over_share || island_trial)) {
         ++island_refinements;
@@ -852,7 +865,12 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       // surface crosses once more and rebuild, rather than keep a mesh that misses them.
       const long euler = euler_characteristic<3>(fe.mesh);
       const bool topology_wrong = s.euler_characteristic() % 2 == 0 && euler != s.euler_characteristic() / 2;
-      if (topology_wrong || r.n_islands_dropped > 0) {
+      // Not for islands alone where the island trial showed that one level more does not
+      // resolve them: refining every octant on the surface is that refinement and more (rotor
+      // L5: 14125 octants refined, then 678 -> 338 -> 736 -> 439 problems over the repairs, the
+      // valid mesh before it standing in the end, minutes of CPU later).
+      const bool islands_unresolvable = island_trial_reverted && !topology_wrong;
+      if ((topology_wrong || r.n_islands_dropped > 0) && !islands_unresolvable) {
         Flags flags(tree.n_leaves(), 0);
         std::size_t n_marked = 0;
         for (std::size_t i = 0; i < tree.n_leaves(); ++i)

@@ -74,8 +74,9 @@ struct Options3d {
   /// thinner (SurfaceBoundary::thickness) than this x their size; 0 = off.
   double thin_cells = 1.5;
   /// An island refinement that would split more than this share of the leaves is tried once
-  /// per run and kept only if the volume of the octants dropped as islands shrinks (a tube two
-  /// octants thick: resolved; rotor's blades at level 4: more islands, the tree before it stays).
+  /// per run and kept only if no island is left (a tube two octants thick: resolved; rotor's
+  /// blades at levels 4 and 5: islands left, the tree before it stays), and then the octants on
+  /// the surface are not all refined for islands either (topology_refinements).
   double island_max_fraction = 0.12;
   /// Octants wanted across the solid's thickness (SurfaceBoundary's thickness level, 0 = off),
   /// up to level + thickness_extra_levels.

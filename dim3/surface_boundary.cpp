@@ -76,6 +76,18 @@ const std::vector<double>& SurfaceBoundary::thicknesses() {
   return thickness_;
 }
 
+double SurfaceBoundary::thin_share(double h) {
+  const std::vector<double>& thick = thicknesses();
+  double thin = 0.0, all = 0.0;
+  for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) {
+    const Triangle& tr = surface_.triangle(t);
+    const double a = 0.5 * (surface_.vertex(tr[1]) - surface_.vertex(tr[0])).cross(surface_.vertex(tr[2]) - surface_.vertex(tr[0])).norm();
+    all += a;
+    if (thick[t] < h) thin += a;
+  }
+  return all > 0 ? thin / all : 0.0;
+}
+
 void SurfaceBoundary::set_thickness_level(double cells, double max_level) {
   options_.thickness_cells = cells;
   options_.thickness_max_level = max_level;

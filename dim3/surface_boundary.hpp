@@ -76,6 +76,8 @@ class SurfaceBoundary final : public Boundary<3> {
   void set_thickness_level(double cells, double max_level);
   /// thickness(t) of every triangle, computed once.
   const std::vector<double>& thicknesses();
+  /// Share of the surface's area whose thickness (thickness(t)) is below `h`.
+  double thin_share(double h);
   double global_level() const { return options_.global_level; }
   double max_level() const { return options_.max_level; }
   /// Thickness of the solid behind triangle t: the distance from its centroid straight inwards

@@ -186,6 +186,14 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--target-dihedral") opt.target_dihedral_deg = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--smooth") opt.smoothing_iterations = std::atoi(argv[i + 1]);
   }
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--thin-share") {
+      // Share of the surface thinner than k octants of the global level (the thin-first rule).
+      const double h = s.root_box().extent()[0] / std::ldexp(1.0, level);
+      std::printf("THIN %s L%d octant %.4g: share thinner than 0.5/1/1.5/2 octants %.4f %.4f %.4f %.4f\n", path.c_str(),
+                  level, h, s.thin_share(0.5 * h), s.thin_share(h), s.thin_share(1.5 * h), s.thin_share(2 * h));
+      return 0;
+    }
   bool quality = false;
   for (int i = 1; i < argc; ++i) quality = quality || std::string(argv[i]) == "--quality";
   for (int i = 1; i < argc; ++i)
