@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
+#include "dim3/moving_tet.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -58,46 +59,6 @@ double angle_rank(double angle) {
   return 1.0 - c * std::abs(c);
 }
 
-/// A tetrahedron seen from one of its nodes, v: the other three in an order that keeps the
-/// orientation with v first, and what does not depend on where v is. rank(x) is
-/// tet_search_rank of the tetrahedron with v at x (the same formula, fewer operations).
-struct MovingTet {
-  P3 q1, q2, q3, n0;   // n0: outward normal of the face opposite v
-  double inv0 = 0.0;   // 1 / |n0|^2, 0 for a zero-area face
-  double l2_fixed = 0.0;  // squared lengths of the three edges away from v
-  void set(const Tet& t, std::int32_t v, const std::vector<P3>& pts) {
-    // Even permutations that bring local node k first.
-    static constexpr int order[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-    const int k = t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : 3;
-    q1 = pts[t[order[k][1]]], q2 = pts[t[order[k][2]]], q3 = pts[t[order[k][3]]];
-    const P3 bc = q2 - q1, bd = q3 - q1, cd = q3 - q2;
-    n0 = bc.cross(bd);
-    const double s0 = n0.squaredNorm();
-    inv0 = s0 > 0 ? 1.0 / s0 : 0.0;
-    l2_fixed = bc.squaredNorm() + bd.squaredNorm() + cd.squaredNorm();
-  }
-  double rank(const P3& x) const {
-    const P3 ab = q1 - x, ac = q2 - x, ad = q3 - x;
-    const P3 n1 = ad.cross(ac), n2 = ab.cross(ad), n3 = ac.cross(ab);
-    const double v6 = -ab.dot(n1);
-    const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + l2_fixed) / 6.0;
-    if (l2 <= 0) return -2.0;
-    if (!(v6 > 0 && 2.0 * v6 * v6 > 1e-18 * l2 * l2 * l2) || !(inv0 > 0))
-      return std::min(std::sqrt(2.0) * v6 / (l2 * std::sqrt(l2)), 0.0) - 1.0;
-    const double s1 = n1.squaredNorm(), s2 = n2.squaredNorm(), s3 = n3.squaredNorm();
-    if (!(s1 > 0 && s2 > 0 && s3 > 0)) return 0.0;
-    const double i1 = 1.0 / s1, i2 = 1.0 / s2, i3 = 1.0 / s3;
-    const auto term = [](double dd, double inv) { return dd * std::abs(dd) * inv; };
-    double best = term(-n0.dot(n1), inv0 * i1);
-    best = std::max(best, term(-n0.dot(n2), inv0 * i2));
-    best = std::max(best, term(-n0.dot(n3), inv0 * i3));
-    best = std::max(best, term(-n1.dot(n2), i1 * i2));
-    best = std::max(best, term(-n1.dot(n3), i1 * i3));
-    best = std::max(best, term(-n2.dot(n3), i2 * i3));
-    return 1.0 - std::clamp(best, -1.0, 1.0);
-  }
-};
-
 constexpr int max_tangent_planes = 3;
 constexpr int max_tangent_candidates = max_tangent_planes * 3 * 2;
 
@@ -119,6 +80,7 @@ struct Optimizer {
   /// One thread's working space for relax.
   struct alignas(64) Scratch {
     std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
+    std::vector<MovingTets2> pairs;  ///< the same two by two (the last one twice if odd)
     std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
     std::size_t moves = 0;
   };
@@ -176,29 +138,51 @@ struct Optimizer {
     }
     return w;
   }
-  static P3 gradient(const MovingTet& m, const P3& x, double h) {
+  /// The central-difference gradient of local tetrahedron k's rank at x, step h.
+  static P3 gradient(const Scratch& sc, std::size_t k, const P3& x, double h) {
+    using V = MovingTets2::V;
+    MovingTets2 both;
+    both.set_all(sc.local[k]);
     P3 g;
     for (int d = 0; d < 3; ++d) {
-      P3 xp = x, xm = x;
-      xp[d] += h;
-      xm[d] -= h;
-      g[d] = (m.rank(xp) - m.rank(xm)) / (2 * h);
+      // Lane 0 at x + h e_d, lane 1 at x - h e_d.
+      std::array<V, 3> at = {MovingTets2::splat(x[0]), MovingTets2::splat(x[1]), MovingTets2::splat(x[2])};
+      at[d] = V{x[d] + h, x[d] - h};
+      V r;
+      MovingTets2::M odd;
+      both.rank(at[0], at[1], at[2], r, odd);
+      for (int l = 0; l < 2; ++l)
+        if (odd[l]) r[l] = sc.local[k].rank(P3(at[0][l], at[1][l], at[2][l]));
+      g[d] = (r[0] - r[1]) / (2 * h);
     }
     return g;
   }
-  /// worst_above over sc.local (relax's incident tetrahedra).
+  /// worst_above over sc.local (relax's incident tetrahedra), two at a time: the ranks in
+  /// sc.trial, and some value <= bound as soon as one is. The pair of `first` (the one likeliest
+  /// to fail) is tried first, and `first` becomes the one that failed.
   /// Without an early stop, sc.trial[i] holds every incident tetrahedron's rank at x.
   static double local_worst_above(Scratch& sc, const P3& x, double bound, std::int32_t& first) {
     const std::vector<MovingTet>& local = sc.local;
     std::vector<double>& trial = sc.trial;
     const std::int32_t n = static_cast<std::int32_t>(local.size());
+    const std::int32_t n_pairs = static_cast<std::int32_t>(sc.pairs.size());
+    const MovingTets2::V vx = MovingTets2::splat(x[0]), vy = MovingTets2::splat(x[1]), vz = MovingTets2::splat(x[2]);
+    const std::int32_t p0 = first / 2;
     double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t j = 0; j < n; ++j) {
-      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
-      trial[i] = local[i].rank(x);
-      w = std::min(w, trial[i]);
-      if (w <= bound) {
-        first = i;
+    for (std::int32_t j = 0; j < n_pairs; ++j) {
+      const std::int32_t p = j == 0 ? p0 : j <= p0 ? j - 1 : j;
+      MovingTets2::V r;
+      MovingTets2::M odd;
+      sc.pairs[p].rank(vx, vy, vz, r, odd);
+      std::int32_t failed = -1;
+      for (std::int32_t l = 0; l < 2 && 2 * p + l < n; ++l) {
+        const std::int32_t i = 2 * p + l;
+        trial[i] = odd[l] ? local[i].rank(x) : r[l];
+        w = std::min(w, trial[i]);
+        if (failed < 0 && trial[i] <= bound) failed = i;
+      }
+      if (failed >= 0) {
+        first = failed;
         return w;
       }
     }
@@ -408,9 +392,12 @@ struct Optimizer {
     trial.resize(local.size());
     best_ranks.resize(local.size());
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) local[k - start[v]].set(tets[incident[k]], v, mesh.points);
+    sc.pairs.resize((local.size() + 1) / 2);
+    for (std::size_t k = 0; k < sc.pairs.size(); ++k)
+      for (std::size_t l = 0; l < 2; ++l) sc.pairs[k].set_lane(static_cast<int>(l), local[std::min(2 * k + l, local.size() - 1)]);
     std::array<P3, 2> dirs;
     int n_dirs = 0;
-    const P3 g = gradient(local[worst_local], x0, h);
+    const P3 g = gradient(sc, static_cast<std::size_t>(worst_local), x0, h);
     if (g.norm() > 0) dirs[n_dirs++] = g.normalized();
     P3 sum = P3::Zero();
     // The nearly worst: within 0.02 rad of the worst angle.
@@ -420,7 +407,7 @@ struct Optimizer {
       const double q = tet_q[t];
       if (q <= near || (f0 <= 0 && q <= 0)) {
         // The worst tetrahedron's gradient is g (the same numbers).
-        const P3 gt = k - start[v] == worst_local ? g : gradient(local[k - start[v]], x0, h);
+        const P3 gt = k - start[v] == worst_local ? g : gradient(sc, static_cast<std::size_t>(k - start[v]), x0, h);
         if (gt.norm() > 0) sum += gt.normalized();
       }
     }
