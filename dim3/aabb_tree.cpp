@@ -47,6 +47,14 @@ AabbTree::AabbTree(const std::vector<P3>& vertices, const std::vector<Triangle>&
     slot_[ids_[s]] = s;
   }
   points_ = std::move(by_slot);
+  boxes_.resize(n);
+  double coordinate = 0.0;
+  for (std::int32_t s = 0; s < n; ++s) {
+    boxes_[s] = Box<3>::empty();
+    for (const P3& q : points_[s]) boxes_[s].expand(q), coordinate = std::max(coordinate, q.cwiseAbs().maxCoeff());
+  }
+  const double scale = coordinate + nodes_[0].box.extent().norm();
+  slack2_ = (1e-8 * scale) * (1e-8 * scale);
 }
 
 void AabbTree::build(std::int32_t node, std::int32_t begin, std::int32_t end,
@@ -85,6 +93,15 @@ void AabbTree::build(std::int32_t node, std::int32_t begin, std::int32_t end,
 
 AabbTree::Closest AabbTree::closest(const P3& p) const {
   return closest_if(p, [](std::int32_t) { return false; });
+}
+
+AabbTree::Closest AabbTree::closest(const P3& p, std::int32_t hint) const {
+  double bound = std::numeric_limits<double>::infinity();
+  if (hint >= 0 && hint < n_triangles()) {
+    const auto& q = points(hint);
+    bound = (closest_on_triangle(p, q[0], q[1], q[2]).point - p).squaredNorm() * (1.0 + 1e-9) + slack2_;
+  }
+  return closest_within(p, bound, [](std::int32_t) { return false; });
 }
 
 bool AabbTree::overlaps(const Box<3>& box) const {
