@@ -1,9 +1,9 @@
 #pragma once
 // The tet optimiser's inner kernel (tet_optimize.cpp): the search rank of a tetrahedron as one
-// of its nodes, v, moves. MovingTet is the scalar original (the slow twin); MovingTets2 ranks
-// two tetrahedra, or one at two points, at once with the same operations lane by lane (GCC and
-// Clang vector extensions: one SSE2 instruction per operation), so its ranks equal
-// MovingTet::rank's bit for bit and the optimiser's mesh does not change. Lanes off the common case (inverted, flat or degenerate tetrahedra) are
+// of its nodes, v, moves. MovingTet is the scalar original (the slow twin); MovingTetLanes ranks
+// N tetrahedra, or one at N points, at once with the same operations lane by lane (GCC and
+// Clang vector extensions), so its ranks equal MovingTet::rank's bit for bit and the
+// optimiser's mesh does not change. Lanes off the common case (inverted, flat or degenerate tetrahedra) are
 // handed back to MovingTet::rank.
 //
 // Bit equality needs every lane to do MovingTet::rank's IEEE operations in its order: Eigen
@@ -62,16 +62,37 @@ struct MovingTet {
   }
 };
 
-/// Two lanes of MovingTet: two tetrahedra, or one tetrahedron twice. Two, the SSE2 register:
-/// four-double vectors without AVX would be split in two anyway, and change the ABI.
-struct MovingTets2 {
+// Four-double vectors passed between functions compiled without AVX change the ABI (GCC warns
+// -Wpsabi); every function here that takes or returns one is inlined into its caller.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+/// N-double vectors and their lane masks (all bits or none). Spelled out per N: GCC ignores
+/// vector_size with a size that depends on a template parameter.
+template <int N> struct Lanes;
+template <> struct Lanes<2> {
   using V = double __attribute__((vector_size(16)));
-  using M = std::int64_t __attribute__((vector_size(16)));  // lane masks: all bits or none
-  static constexpr int n_lanes = 2;
+  using M = std::int64_t __attribute__((vector_size(16)));
+};
+template <> struct Lanes<4> {
+  using V = double __attribute__((vector_size(32)));
+  using M = std::int64_t __attribute__((vector_size(32)));
+};
 
-  V q1[3], q2[3], q3[3], n0[3], inv0, l2_fixed;
+/// N lanes of MovingTet (N tetrahedra, or one tetrahedron N times), stored field by field.
+/// rank() works on N-double vectors: with N = 2 one SSE2 instruction per operation; with N = 4
+/// one AVX instruction when called from a function compiled for AVX (tet_optimize.cpp picks it
+/// at run time), else two SSE2 ones.
+template <int N> struct MovingTetLanes {
+  static_assert(N == 2 || N == 4);
+  static constexpr int n_lanes = N;
+  using V = typename Lanes<N>::V;
+  using M = typename Lanes<N>::M;
 
-  static V splat(double a) { return V{a, a}; }
+  alignas(8 * N) double q1[3][N], q2[3][N], q3[3][N], n0[3][N], inv0[N], l2_fixed[N];
+
   /// Lane `lane` := m.
   void set_lane(int lane, const MovingTet& m) {
     for (int d = 0; d < 3; ++d)
@@ -80,59 +101,80 @@ struct MovingTets2 {
   }
   /// Every lane := m.
   void set_all(const MovingTet& m) {
-    for (int d = 0; d < 3; ++d) q1[d] = splat(m.q1[d]), q2[d] = splat(m.q2[d]), q3[d] = splat(m.q3[d]), n0[d] = splat(m.n0[d]);
-    inv0 = splat(m.inv0), l2_fixed = splat(m.l2_fixed);
+    for (int l = 0; l < N; ++l) set_lane(l, m);
   }
 
-  /// MovingTet::rank of each lane at its point (x, y, z): the common case (positive volume,
-  /// no zero-area face) in the result, and in `odd` the lanes (all bits set) that are not, for
-  /// MovingTet::rank to redo.
-  void rank(const V& x, const V& y, const V& z, V& out, M& odd) const {
-    const V ab[3] = {q1[0] - x, q1[1] - y, q1[2] - z};
-    const V ac[3] = {q2[0] - x, q2[1] - y, q2[2] - z};
-    const V ad[3] = {q3[0] - x, q3[1] - y, q3[2] - z};
+  /// MovingTet::rank of lane l at (x[l], y[l], z[l]) into out[l] for the lanes in the common
+  /// case (positive volume, no zero-area face); returns the others as bits (lane l: 1 << l),
+  /// for MovingTet::rank to redo.
+  [[gnu::always_inline]] unsigned rank(const double* x, const double* y, const double* z, double* out) const {
+    const V px = load(x), py = load(y), pz = load(z);
+    const V ab[3] = {load(q1[0]) - px, load(q1[1]) - py, load(q1[2]) - pz};
+    const V ac[3] = {load(q2[0]) - px, load(q2[1]) - py, load(q2[2]) - pz};
+    const V ad[3] = {load(q3[0]) - px, load(q3[1]) - py, load(q3[2]) - pz};
     V n1[3], n2[3], n3[3];
     cross(ad, ac, n1);
     cross(ab, ad, n2);
     cross(ac, ab, n3);
     const V v6 = -dot(ab, n1);
-    const V l2 = (((dot(ab, ab) + dot(ac, ac)) + dot(ad, ad)) + l2_fixed) / 6.0;
+    const V l2 = (((dot(ab, ab) + dot(ac, ac)) + dot(ad, ad)) + load(l2_fixed)) / 6.0;
     const V s1 = dot(n1, n1), s2 = dot(n2, n2), s3 = dot(n3, n3);
+    const V in0 = load(inv0);
     const V zero = splat(0.0);
     // The common case, as MovingTet::rank's tests; NaN fails every comparison, as there.
-    const M ok = (l2 > zero) & (v6 > zero) & ((2.0 * v6) * v6 > ((1e-18 * l2) * l2) * l2) & (inv0 > zero) &
-                  (s1 > zero) & (s2 > zero) & (s3 > zero);
-    odd = ~ok;
+    const M ok = (l2 > zero) & (v6 > zero) & ((2.0 * v6) * v6 > ((1e-18 * l2) * l2) * l2) & (in0 > zero) &
+                 (s1 > zero) & (s2 > zero) & (s3 > zero);
     const V one = splat(1.0);
     const V i1 = one / s1, i2 = one / s2, i3 = one / s3;
-    V best = term(-dot(n0, n1), inv0 * i1);
-    best = max(best, term(-dot(n0, n2), inv0 * i2));
-    best = max(best, term(-dot(n0, n3), inv0 * i3));
+    const V m0[3] = {load(n0[0]), load(n0[1]), load(n0[2])};
+    V best = term(-dot(m0, n1), in0 * i1);
+    best = max(best, term(-dot(m0, n2), in0 * i2));
+    best = max(best, term(-dot(m0, n3), in0 * i3));
     best = max(best, term(-dot(n1, n2), i1 * i2));
     best = max(best, term(-dot(n1, n3), i1 * i3));
     best = max(best, term(-dot(n2, n3), i2 * i3));
     // std::clamp(best, -1, 1): best < -1 ? -1 : 1 < best ? 1 : best.
     best = select(best < -one, -one, select(one < best, one, best));
-    out = one - best;
+    const V r = one - best;
+    __builtin_memcpy(out, &r, sizeof r);
+    unsigned odd = 0;
+    for (int l = 0; l < N; ++l) odd |= ok[l] ? 0u : 1u << l;
+    return odd;
   }
 
  private:
-  static V dot(const V (&a)[3], const V (&b)[3]) { return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2]; }
-  static void cross(const V (&a)[3], const V (&b)[3], V (&c)[3]) {
+  [[gnu::always_inline]] static V load(const double* a) {
+    V v;
+    __builtin_memcpy(&v, a, sizeof v);
+    return v;
+  }
+  [[gnu::always_inline]] static V splat(double a) {
+    V v;
+    for (int l = 0; l < N; ++l) v[l] = a;
+    return v;
+  }
+  [[gnu::always_inline]] static V dot(const V (&a)[3], const V (&b)[3]) {
+    return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
+  }
+  [[gnu::always_inline]] static void cross(const V (&a)[3], const V (&b)[3], V (&c)[3]) {
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
   }
-  static V select(const M& m, const V& a, const V& b) {
+  [[gnu::always_inline]] static V select(const M& m, const V& a, const V& b) {
     return reinterpret_cast<V>((m & reinterpret_cast<M>(a)) | (~m & reinterpret_cast<M>(b)));
   }
-  /// std::max(a, b) = a < b ? b : a (ties and NaN keep a).
-  static V max(const V& a, const V& b) { return select(a < b, b, a); }
+  /// std::max(a, b) = a < b ? b : a (ties and NaN keep a): one maxpd.
+  [[gnu::always_inline]] static V max(const V& a, const V& b) { return a < b ? b : a; }
   /// dd * |dd| * inv, |dd| by clearing the sign bit (std::abs).
-  static V term(const V& dd, const V& inv) {
-    const V abs_dd = reinterpret_cast<V>(reinterpret_cast<M>(dd) & M{INT64_MAX, INT64_MAX});
+  [[gnu::always_inline]] static V term(const V& dd, const V& inv) {
+    const V abs_dd = reinterpret_cast<V>(reinterpret_cast<M>(dd) & (M{} + INT64_MAX));
     return dd * abs_dd * inv;
   }
 };
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
 
 }  // namespace febemesh::dim3

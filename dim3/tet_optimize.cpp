@@ -59,6 +59,81 @@ double angle_rank(double angle) {
   return 1.0 - c * std::abs(c);
 }
 
+/// The central-difference gradient of m's rank at x, step h, N points at a time.
+template <int N> [[gnu::always_inline]] inline P3 lanes_gradient(const MovingTet& m, const P3& x, double h) {
+  // Points 2d and 2d + 1: x + h e_d and x - h e_d (then copies of the last to fill the lanes).
+  constexpr int n_points = (6 + N - 1) / N * N;
+  double at[3][n_points], r[n_points];
+  for (int k = 0; k < n_points; ++k) {
+    const int d = std::min(k, 5) / 2;
+    for (int c = 0; c < 3; ++c) at[c][k] = x[c];
+    at[d][k] = std::min(k, 5) % 2 == 0 ? x[d] + h : x[d] - h;
+  }
+  MovingTetLanes<N> lanes;
+  lanes.set_all(m);
+  for (int k = 0; k < n_points; k += N) {
+    const unsigned odd = lanes.rank(&at[0][k], &at[1][k], &at[2][k], &r[k]);
+    for (int l = 0; l < N; ++l)
+      if (odd >> l & 1u) r[k + l] = m.rank(P3(at[0][k + l], at[1][k + l], at[2][k + l]));
+  }
+  P3 g;
+  for (int d = 0; d < 3; ++d) g[d] = (r[2 * d] - r[2 * d + 1]) / (2 * h);
+  return g;
+}
+
+/// The worst rank over `local` at x, N at a time (blocks: `local` in lanes), into trial; some
+/// value <= bound as soon as one is. The block of `first` (the one likeliest to fail) is tried
+/// first, and `first` becomes the one that failed. Without an early stop, trial[i] holds every
+/// rank at x.
+template <int N>
+[[gnu::always_inline]] inline double lanes_worst_above(const std::vector<MovingTet>& local, const MovingTetLanes<N>* blocks,
+                                                       double* trial, const P3& x, double bound, std::int32_t& first) {
+  const std::int32_t n = static_cast<std::int32_t>(local.size());
+  const std::int32_t n_blocks = (n + N - 1) / N;
+  double at[3][N];
+  for (int c = 0; c < 3; ++c)
+    for (int l = 0; l < N; ++l) at[c][l] = x[c];
+  const std::int32_t b0 = first / N;
+  double w = std::numeric_limits<double>::infinity();
+  for (std::int32_t j = 0; j < n_blocks; ++j) {
+    const std::int32_t b = j == 0 ? b0 : j <= b0 ? j - 1 : j;
+    double r[N];
+    const unsigned odd = blocks[b].rank(at[0], at[1], at[2], r);
+    std::int32_t failed = -1;
+    for (std::int32_t l = 0; l < N && N * b + l < n; ++l) {
+      const std::int32_t i = N * b + l;
+      trial[i] = odd >> l & 1u ? local[i].rank(x) : r[l];
+      w = std::min(w, trial[i]);
+      if (failed < 0 && trial[i] <= bound) failed = i;
+    }
+    if (failed >= 0) {
+      first = failed;
+      return w;
+    }
+  }
+  return w;
+}
+
+// Four lanes in AVX registers where the CPU has them (AVX without FMA: SSE2's roundings).
+// MovingTetLanes<4>'s vector helpers are all inlined into the AVX functions; GCC still warns,
+// at the end of the file, that their four-double arguments would change the ABI without AVX.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FEBEMESH_TARGET_AVX [[gnu::target("avx")]]
+bool has_avx() { return __builtin_cpu_supports("avx"); }
+#else
+#define FEBEMESH_TARGET_AVX
+bool has_avx() { return false; }
+#endif
+FEBEMESH_TARGET_AVX P3 lanes_gradient_avx(const MovingTet& m, const P3& x, double h) { return lanes_gradient<4>(m, x, h); }
+FEBEMESH_TARGET_AVX double lanes_worst_above_avx(const std::vector<MovingTet>& local, const MovingTetLanes<4>* blocks,
+                                                 double* trial, const P3& x, double bound, std::int32_t& first) {
+  return lanes_worst_above<4>(local, blocks, trial, x, bound, first);
+}
+#undef FEBEMESH_TARGET_AVX
+
 constexpr int max_tangent_planes = 3;
 constexpr int max_tangent_candidates = max_tangent_planes * 3 * 2;
 
@@ -77,10 +152,13 @@ struct Optimizer {
   std::vector<double> tet_q;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
   double tangent_rank = 0.0;  ///< angle_rank of opt.tangent_below_deg
+  bool avx = has_avx();  ///< rank four lanes at a time in AVX registers
   /// One thread's working space for relax.
   struct alignas(64) Scratch {
     std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
-    std::vector<MovingTets2> pairs;  ///< the same two by two (the last one twice if odd)
+    /// The same in blocks of lanes (the last one padded with copies): fours with AVX, else pairs.
+    std::vector<MovingTetLanes<4>> quads;
+    std::vector<MovingTetLanes<2>> pairs;
     std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
     std::size_t moves = 0;
   };
@@ -138,55 +216,14 @@ struct Optimizer {
     }
     return w;
   }
-  /// The central-difference gradient of local tetrahedron k's rank at x, step h.
-  static P3 gradient(const Scratch& sc, std::size_t k, const P3& x, double h) {
-    using V = MovingTets2::V;
-    MovingTets2 both;
-    both.set_all(sc.local[k]);
-    P3 g;
-    for (int d = 0; d < 3; ++d) {
-      // Lane 0 at x + h e_d, lane 1 at x - h e_d.
-      std::array<V, 3> at = {MovingTets2::splat(x[0]), MovingTets2::splat(x[1]), MovingTets2::splat(x[2])};
-      at[d] = V{x[d] + h, x[d] - h};
-      V r;
-      MovingTets2::M odd;
-      both.rank(at[0], at[1], at[2], r, odd);
-      for (int l = 0; l < 2; ++l)
-        if (odd[l]) r[l] = sc.local[k].rank(P3(at[0][l], at[1][l], at[2][l]));
-      g[d] = (r[0] - r[1]) / (2 * h);
-    }
-    return g;
+  P3 gradient(const MovingTet& m, const P3& x, double h) const {
+    return avx ? lanes_gradient_avx(m, x, h) : lanes_gradient<2>(m, x, h);
   }
-  /// worst_above over sc.local (relax's incident tetrahedra), two at a time: the ranks in
-  /// sc.trial, and some value <= bound as soon as one is. The pair of `first` (the one likeliest
-  /// to fail) is tried first, and `first` becomes the one that failed.
-  /// Without an early stop, sc.trial[i] holds every incident tetrahedron's rank at x.
-  static double local_worst_above(Scratch& sc, const P3& x, double bound, std::int32_t& first) {
-    const std::vector<MovingTet>& local = sc.local;
-    std::vector<double>& trial = sc.trial;
-    const std::int32_t n = static_cast<std::int32_t>(local.size());
-    const std::int32_t n_pairs = static_cast<std::int32_t>(sc.pairs.size());
-    const MovingTets2::V vx = MovingTets2::splat(x[0]), vy = MovingTets2::splat(x[1]), vz = MovingTets2::splat(x[2]);
-    const std::int32_t p0 = first / 2;
-    double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t j = 0; j < n_pairs; ++j) {
-      const std::int32_t p = j == 0 ? p0 : j <= p0 ? j - 1 : j;
-      MovingTets2::V r;
-      MovingTets2::M odd;
-      sc.pairs[p].rank(vx, vy, vz, r, odd);
-      std::int32_t failed = -1;
-      for (std::int32_t l = 0; l < 2 && 2 * p + l < n; ++l) {
-        const std::int32_t i = 2 * p + l;
-        trial[i] = odd[l] ? local[i].rank(x) : r[l];
-        w = std::min(w, trial[i]);
-        if (failed < 0 && trial[i] <= bound) failed = i;
-      }
-      if (failed >= 0) {
-        first = failed;
-        return w;
-      }
-    }
-    return w;
+  /// local in blocks of lanes, the last one padded with copies of the last tetrahedron.
+  template <int N> static void fill_blocks(const std::vector<MovingTet>& local, std::vector<MovingTetLanes<N>>& blocks) {
+    blocks.resize((local.size() + N - 1) / N);
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      for (std::size_t l = 0; l < N; ++l) blocks[k].set_lane(static_cast<int>(l), local[std::min(N * k + l, local.size() - 1)]);
   }
   /// Escobar et al.'s untangling objective of tetrahedron t with v at x: |S|^2 / (3 h(s)^(2/3)),
   /// S its Jacobian against the regular tetrahedron of edge `scale`, s = det S and
@@ -392,12 +429,13 @@ struct Optimizer {
     trial.resize(local.size());
     best_ranks.resize(local.size());
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) local[k - start[v]].set(tets[incident[k]], v, mesh.points);
-    sc.pairs.resize((local.size() + 1) / 2);
-    for (std::size_t k = 0; k < sc.pairs.size(); ++k)
-      for (std::size_t l = 0; l < 2; ++l) sc.pairs[k].set_lane(static_cast<int>(l), local[std::min(2 * k + l, local.size() - 1)]);
+    if (avx)
+      fill_blocks(local, sc.quads);
+    else
+      fill_blocks(local, sc.pairs);
     std::array<P3, 2> dirs;
     int n_dirs = 0;
-    const P3 g = gradient(sc, static_cast<std::size_t>(worst_local), x0, h);
+    const P3 g = gradient(local[worst_local], x0, h);
     if (g.norm() > 0) dirs[n_dirs++] = g.normalized();
     P3 sum = P3::Zero();
     // The nearly worst: within 0.02 rad of the worst angle.
@@ -407,7 +445,7 @@ struct Optimizer {
       const double q = tet_q[t];
       if (q <= near || (f0 <= 0 && q <= 0)) {
         // The worst tetrahedron's gradient is g (the same numbers).
-        const P3 gt = k - start[v] == worst_local ? g : gradient(sc, static_cast<std::size_t>(k - start[v]), x0, h);
+        const P3 gt = k - start[v] == worst_local ? g : gradient(local[k - start[v]], x0, h);
         if (gt.norm() > 0) sum += gt.normalized();
       }
     }
@@ -439,7 +477,8 @@ struct Optimizer {
       P3 x;
       BoundaryLocation w;
       place(v, x0, c, x, w);
-      double f = local_worst_above(sc, x, best + 1e-12, worst_local);
+      double f = avx ? lanes_worst_above_avx(local, sc.quads.data(), trial.data(), x, best + 1e-12, worst_local)
+                     : lanes_worst_above<2>(local, sc.pairs.data(), trial.data(), x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }
