@@ -62,9 +62,10 @@ struct MovingTet {
   }
 };
 
-// Four-double vectors passed between functions compiled without AVX change the ABI (GCC warns
-// -Wpsabi); every function here that takes or returns one is inlined into its caller.
-#if defined(__GNUC__) && !defined(__clang__)
+// Four-double vectors passed between functions compiled without AVX change the ABI (GCC and
+// Clang warn, -Wpsabi); every function here that takes or returns one is inlined into its
+// caller.
+#if defined(__GNUC__)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
@@ -173,7 +174,7 @@ template <int N> struct MovingTetLanes {
   }
 };
 
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__)
 #pragma GCC diagnostic pop
 #endif
 

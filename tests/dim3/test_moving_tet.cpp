@@ -83,7 +83,7 @@ template <int N, class Ranks> Tally compare_lanes(int rounds, Ranks&& ranks) {
 }
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#if defined(__GNUC__) && !defined(__clang__)
+#if defined(__GNUC__)
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 [[gnu::target("avx")]] unsigned ranks_avx(const MovingTetLanes<4>& lanes, const double* x, const double* y,
