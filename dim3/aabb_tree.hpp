@@ -91,14 +91,31 @@ template <class Skip> AabbTree::Closest AabbTree::closest_if(const P3& p, Skip&&
 template <class Skip> AabbTree::Closest AabbTree::closest_within(const P3& p, double bound, Skip&& skip) const {
   Closest best;
   if (nodes_.empty()) return best;
-  std::array<std::pair<std::int32_t, double>, 128> stack;
+  // Depth first, the nearer child first. A node is cut when its box is no nearer than the
+  // best so far or beyond the bound; the farther child is cut when it is pushed already if it
+  // is then (the best only shrinks), and the nearer one is visited at once, not pushed.
+  // The stack is left uninitialised (std::pair entries would zero 2 KB on every query).
+  struct Entry {
+    std::int32_t node;
+    double d2;
+  };
+  Entry stack[128];
   int top = 0;
-  stack[top++] = {0, box_distance2(nodes_[0].box, p)};
-  while (top > 0) {
-    const auto [n, d2] = stack[--top];
-    if (d2 >= best.distance2 || d2 > bound) continue;
-    const Node& node = nodes_[n];
-    if (node.count > 0) {
+  std::int32_t n = 0;
+  double d2 = box_distance2(nodes_[0].box, p);
+  for (;;) {
+    if (d2 < best.distance2 && d2 <= bound) {
+      const Node& node = nodes_[n];
+      if (node.count == 0) {
+        const double dl = box_distance2(nodes_[node.first].box, p);
+        const double dr = box_distance2(nodes_[node.first + 1].box, p);
+        const bool left_first = dl <= dr;
+        const double d_far = left_first ? dr : dl;
+        if (d_far < best.distance2 && d_far <= bound) stack[top++] = {left_first ? node.first + 1 : node.first, d_far};
+        n = left_first ? node.first : node.first + 1;
+        d2 = left_first ? dl : dr;
+        continue;
+      }
       // A triangle whose box is farther than the best so far (beyond the rounding) cannot
       // become the best: its distance is not computed.
       const double reach = std::min(best.distance2, bound) * (1.0 + 1e-9) + slack2_;
@@ -110,18 +127,10 @@ template <class Skip> AabbTree::Closest AabbTree::closest_within(const P3& p, do
         const double dist2 = (tp.point - p).squaredNorm();
         if (dist2 < best.distance2) best = {ids_[s], tp, dist2};
       }
-      continue;
     }
-    const double dl = box_distance2(nodes_[node.first].box, p);
-    const double dr = box_distance2(nodes_[node.first + 1].box, p);
-    // Push the farther child first so the nearer one is explored first.
-    if (dl <= dr) {
-      stack[top++] = {node.first + 1, dr};
-      stack[top++] = {node.first, dl};
-    } else {
-      stack[top++] = {node.first, dl};
-      stack[top++] = {node.first + 1, dr};
-    }
+    if (top == 0) break;
+    --top;
+    n = stack[top].node, d2 = stack[top].d2;
   }
   return best;
 }
