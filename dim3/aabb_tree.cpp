@@ -118,7 +118,8 @@ bool AabbTree::overlaps(const Box<3>& box) const {
 double AabbTree::box_distance2(const Box<3>& b, const P3& p) {
   double d2 = 0.0;
   for (int d = 0; d < 3; ++d) {
-    const double e = std::max({b.lo[d] - p[d], 0.0, p[d] - b.hi[d]});
+    // max(lo - p, 0, p - hi) in two maxsd (std::max of a list: a loop); the same square.
+    const double e = std::max(std::max(b.lo[d] - p[d], p[d] - b.hi[d]), 0.0);
     d2 += e * e;
   }
   return d2;
