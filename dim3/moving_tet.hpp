@@ -3,8 +3,8 @@
 // of its nodes, v, moves. MovingTet is the scalar original (the slow twin); MovingTetLanes ranks
 // N tetrahedra, or one at N points, at once with the same operations lane by lane (GCC and
 // Clang vector extensions), so its ranks equal MovingTet::rank's bit for bit and the
-// optimiser's mesh does not change. Lanes off the common case (inverted, flat or degenerate tetrahedra) are
-// handed back to MovingTet::rank.
+// optimiser's mesh does not change. Lanes off the common case (inverted, flat or degenerate
+// tetrahedra) come back NaN, for MovingTet::rank to redo.
 //
 // Bit equality needs every lane to do MovingTet::rank's IEEE operations in its order: Eigen
 // sums a 3-vector's dot product and squared norm left to right, ((x0 + x1) + x2), and no
@@ -14,6 +14,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/box.hpp"  // Point
@@ -106,9 +107,9 @@ template <int N> struct MovingTetLanes {
   }
 
   /// MovingTet::rank of lane l at (x[l], y[l], z[l]) into out[l] for the lanes in the common
-  /// case (positive volume, no zero-area face); returns the others as bits (lane l: 1 << l),
-  /// for MovingTet::rank to redo.
-  [[gnu::always_inline]] unsigned rank(const double* x, const double* y, const double* z, double* out) const {
+  /// case (positive volume, no zero-area face); NaN in the others, for MovingTet::rank to redo
+  /// (the common case gives NaN only where MovingTet::rank does: redoing it changes nothing).
+  [[gnu::always_inline]] void rank(const double* x, const double* y, const double* z, double* out) const {
     const V px = load(x), py = load(y), pz = load(z);
     const V ab[3] = {load(q1[0]) - px, load(q1[1]) - py, load(q1[2]) - pz};
     const V ac[3] = {load(q2[0]) - px, load(q2[1]) - py, load(q2[2]) - pz};
@@ -136,11 +137,8 @@ template <int N> struct MovingTetLanes {
     best = max(best, term(-dot(n2, n3), i2 * i3));
     // std::clamp(best, -1, 1): best < -1 ? -1 : 1 < best ? 1 : best.
     best = select(best < -one, -one, select(one < best, one, best));
-    const V r = one - best;
+    const V r = select(ok, one - best, splat(std::numeric_limits<double>::quiet_NaN()));
     __builtin_memcpy(out, &r, sizeof r);
-    unsigned odd = 0;
-    for (int l = 0; l < N; ++l) odd |= ok[l] ? 0u : 1u << l;
-    return odd;
   }
 
  private:

@@ -72,9 +72,9 @@ template <int N> [[gnu::always_inline]] inline P3 lanes_gradient(const MovingTet
   MovingTetLanes<N> lanes;
   lanes.set_all(m);
   for (int k = 0; k < n_points; k += N) {
-    const unsigned odd = lanes.rank(&at[0][k], &at[1][k], &at[2][k], &r[k]);
+    lanes.rank(&at[0][k], &at[1][k], &at[2][k], &r[k]);
     for (int l = 0; l < N; ++l)
-      if (odd >> l & 1u) r[k + l] = m.rank(P3(at[0][k + l], at[1][k + l], at[2][k + l]));
+      if (std::isnan(r[k + l])) r[k + l] = m.rank(P3(at[0][k + l], at[1][k + l], at[2][k + l]));
   }
   P3 g;
   for (int d = 0; d < 3; ++d) g[d] = (r[2 * d] - r[2 * d + 1]) / (2 * h);
@@ -98,11 +98,11 @@ template <int N>
   for (std::int32_t j = 0; j < n_blocks; ++j) {
     const std::int32_t b = j == 0 ? b0 : j <= b0 ? j - 1 : j;
     double r[N];
-    const unsigned odd = blocks[b].rank(at[0], at[1], at[2], r);
+    blocks[b].rank(at[0], at[1], at[2], r);
     std::int32_t failed = -1;
     for (std::int32_t l = 0; l < N && N * b + l < n; ++l) {
       const std::int32_t i = N * b + l;
-      trial[i] = odd >> l & 1u ? local[i].rank(x) : r[l];
+      trial[i] = std::isnan(r[l]) ? local[i].rank(x) : r[l];
       w = std::min(w, trial[i]);
       if (failed < 0 && trial[i] <= bound) failed = i;
     }
