@@ -47,6 +47,14 @@ AabbTree::AabbTree(const std::vector<P3>& vertices, const std::vector<Triangle>&
     slot_[ids_[s]] = s;
   }
   points_ = std::move(by_slot);
+  boxes_.resize(n);
+  double coordinate = 0.0;
+  for (std::int32_t s = 0; s < n; ++s) {
+    boxes_[s] = Box<3>::empty();
+    for (const P3& q : points_[s]) boxes_[s].expand(q), coordinate = std::max(coordinate, q.cwiseAbs().maxCoeff());
+  }
+  const double scale = coordinate + nodes_[0].box.extent().norm();
+  slack2_ = (1e-8 * scale) * (1e-8 * scale);
 }
 
 void AabbTree::build(std::int32_t node, std::int32_t begin, std::int32_t end,
@@ -87,6 +95,15 @@ AabbTree::Closest AabbTree::closest(const P3& p) const {
   return closest_if(p, [](std::int32_t) { return false; });
 }
 
+AabbTree::Closest AabbTree::closest(const P3& p, std::int32_t hint) const {
+  double bound = std::numeric_limits<double>::infinity();
+  if (hint >= 0 && hint < n_triangles()) {
+    const auto& q = points(hint);
+    bound = (closest_on_triangle(p, q[0], q[1], q[2]).point - p).squaredNorm() * (1.0 + 1e-9) + slack2_;
+  }
+  return closest_within(p, bound, [](std::int32_t) { return false; });
+}
+
 bool AabbTree::overlaps(const Box<3>& box) const {
   bool found = false;
   // for_each_in_box cannot stop early; the box test prunes enough for the boxes we ask about.
@@ -101,7 +118,8 @@ bool AabbTree::overlaps(const Box<3>& box) const {
 double AabbTree::box_distance2(const Box<3>& b, const P3& p) {
   double d2 = 0.0;
   for (int d = 0; d < 3; ++d) {
-    const double e = std::max({b.lo[d] - p[d], 0.0, p[d] - b.hi[d]});
+    // max(lo - p, 0, p - hi) in two maxsd (std::max of a list: a loop); the same square.
+    const double e = std::max(std::max(b.lo[d] - p[d], p[d] - b.hi[d]), 0.0);
     d2 += e * e;
   }
   return d2;

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "core/box.hpp"
@@ -38,6 +39,10 @@ class AabbTree {
 
   /// Closest point of the surface to p; ties go to the first triangle met (deterministic).
   Closest closest(const P3& p) const;
+  /// closest(p), the same answer, found faster when triangle `hint` (-1: none) is near it: its
+  /// distance bounds the search from the start. The bound carries a slack far above the
+  /// distances' rounding (slack2_), so that no subtree holding the answer is cut.
+  Closest closest(const P3& p, std::int32_t hint) const;
   /// Closest point over triangles with skip(t) false.
   template <class Skip> Closest closest_if(const P3& p, Skip&& skip) const;
 
@@ -64,45 +69,68 @@ class AabbTree {
     std::int32_t count = 0;  ///< leaf: number of triangles; inner: 0
   };
   void build(std::int32_t node, std::int32_t begin, std::int32_t end, const std::vector<P3>& centroids);
+  /// closest_if visiting only boxes within `bound` (squared) of p, and only triangles whose
+  /// box is: the answer when it lies within the bound.
+  template <class Skip> Closest closest_within(const P3& p, double bound, Skip&& skip) const;
 
   std::vector<Node> nodes_;
   std::vector<std::int32_t> ids_;             ///< triangle index in slot order
   std::vector<std::int32_t> slot_;            ///< slot of each triangle
   std::vector<std::array<P3, 3>> points_;     ///< corners in slot order (cache-friendly leaves)
+  std::vector<Box<3>> boxes_;                 ///< box of each triangle, in slot order
+  /// Squared distances this far apart may be rounding: (1e-8 (max |coordinate| + diagonal))^2.
+  double slack2_ = 0.0;
 };
 
 // ---- templates ------------------------------------------------------------------------------
 
 template <class Skip> AabbTree::Closest AabbTree::closest_if(const P3& p, Skip&& skip) const {
+  return closest_within(p, std::numeric_limits<double>::infinity(), std::forward<Skip>(skip));
+}
+
+template <class Skip> AabbTree::Closest AabbTree::closest_within(const P3& p, double bound, Skip&& skip) const {
   Closest best;
   if (nodes_.empty()) return best;
-  std::array<std::pair<std::int32_t, double>, 128> stack;
+  // Depth first, the nearer child first. A node is cut when its box is no nearer than the
+  // best so far or beyond the bound; the farther child is cut when it is pushed already if it
+  // is then (the best only shrinks), and the nearer one is visited at once, not pushed.
+  // The stack is left uninitialised (std::pair entries would zero 2 KB on every query).
+  struct Entry {
+    std::int32_t node;
+    double d2;
+  };
+  Entry stack[128];
   int top = 0;
-  stack[top++] = {0, box_distance2(nodes_[0].box, p)};
-  while (top > 0) {
-    const auto [n, d2] = stack[--top];
-    if (d2 >= best.distance2) continue;
-    const Node& node = nodes_[n];
-    if (node.count > 0) {
+  std::int32_t n = 0;
+  double d2 = box_distance2(nodes_[0].box, p);
+  for (;;) {
+    if (d2 < best.distance2 && d2 <= bound) {
+      const Node& node = nodes_[n];
+      if (node.count == 0) {
+        const double dl = box_distance2(nodes_[node.first].box, p);
+        const double dr = box_distance2(nodes_[node.first + 1].box, p);
+        const bool left_first = dl <= dr;
+        const double d_far = left_first ? dr : dl;
+        if (d_far < best.distance2 && d_far <= bound) stack[top++] = {left_first ? node.first + 1 : node.first, d_far};
+        n = left_first ? node.first : node.first + 1;
+        d2 = left_first ? dl : dr;
+        continue;
+      }
+      // A triangle whose box is farther than the best so far (beyond the rounding) cannot
+      // become the best: its distance is not computed.
+      const double reach = std::min(best.distance2, bound) * (1.0 + 1e-9) + slack2_;
       for (std::int32_t s = node.first; s < node.first + node.count; ++s) {
         if (skip(ids_[s])) continue;
+        if (box_distance2(boxes_[s], p) > reach) continue;
         const auto& q = points_[s];
         const TrianglePoint tp = closest_on_triangle(p, q[0], q[1], q[2]);
         const double dist2 = (tp.point - p).squaredNorm();
         if (dist2 < best.distance2) best = {ids_[s], tp, dist2};
       }
-      continue;
     }
-    const double dl = box_distance2(nodes_[node.first].box, p);
-    const double dr = box_distance2(nodes_[node.first + 1].box, p);
-    // Push the farther child first so the nearer one is explored first.
-    if (dl <= dr) {
-      stack[top++] = {node.first + 1, dr};
-      stack[top++] = {node.first, dl};
-    } else {
-      stack[top++] = {node.first, dl};
-      stack[top++] = {node.first + 1, dr};
-    }
+    if (top == 0) break;
+    --top;
+    n = stack[top].node, d2 = stack[top].d2;
   }
   return best;
 }

@@ -165,7 +165,16 @@ ClosestPoint<3> SurfaceBoundary::to_closest(const AabbTree::Closest& c, const P3
   return out;
 }
 
-ClosestPoint<3> SurfaceBoundary::closest_point(const P3& p) const { return to_closest(tree_.closest(p), p); }
+ClosestPoint<3> SurfaceBoundary::closest_point(const P3& p) const {
+  // The last answer on this thread as the search's hint: callers ask about nearby points in a
+  // row (the tet optimiser's candidates around one node, the fidelity samples along a
+  // triangle). The answer does not depend on it (AabbTree::closest), so neither the thread
+  // count nor the order of calls changes any result.
+  thread_local std::int32_t last = -1;
+  const AabbTree::Closest c = tree_.closest(p, last);
+  last = c.triangle;
+  return to_closest(c, p);
+}
 
 std::vector<ClosestPoint<3>> SurfaceBoundary::closest_points(const P3& p, int max_count) const {
   std::vector<ClosestPoint<3>> out;

@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
+#include "dim3/moving_tet.hpp"
 
 namespace febemesh::dim3 {
 namespace {
@@ -58,45 +59,80 @@ double angle_rank(double angle) {
   return 1.0 - c * std::abs(c);
 }
 
-/// A tetrahedron seen from one of its nodes, v: the other three in an order that keeps the
-/// orientation with v first, and what does not depend on where v is. rank(x) is
-/// tet_search_rank of the tetrahedron with v at x (the same formula, fewer operations).
-struct MovingTet {
-  P3 q1, q2, q3, n0;   // n0: outward normal of the face opposite v
-  double inv0 = 0.0;   // 1 / |n0|^2, 0 for a zero-area face
-  double l2_fixed = 0.0;  // squared lengths of the three edges away from v
-  void set(const Tet& t, std::int32_t v, const std::vector<P3>& pts) {
-    // Even permutations that bring local node k first.
-    static constexpr int order[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
-    const int k = t[0] == v ? 0 : t[1] == v ? 1 : t[2] == v ? 2 : 3;
-    q1 = pts[t[order[k][1]]], q2 = pts[t[order[k][2]]], q3 = pts[t[order[k][3]]];
-    const P3 bc = q2 - q1, bd = q3 - q1, cd = q3 - q2;
-    n0 = bc.cross(bd);
-    const double s0 = n0.squaredNorm();
-    inv0 = s0 > 0 ? 1.0 / s0 : 0.0;
-    l2_fixed = bc.squaredNorm() + bd.squaredNorm() + cd.squaredNorm();
+/// The central-difference gradient of m's rank at x, step h, N points at a time.
+template <int N> [[gnu::always_inline]] inline P3 lanes_gradient(const MovingTet& m, const P3& x, double h) {
+  // Points 2d and 2d + 1: x + h e_d and x - h e_d (then copies of the last to fill the lanes).
+  constexpr int n_points = (6 + N - 1) / N * N;
+  double at[3][n_points], r[n_points];
+  for (int k = 0; k < n_points; ++k) {
+    const int d = std::min(k, 5) / 2;
+    for (int c = 0; c < 3; ++c) at[c][k] = x[c];
+    at[d][k] = std::min(k, 5) % 2 == 0 ? x[d] + h : x[d] - h;
   }
-  double rank(const P3& x) const {
-    const P3 ab = q1 - x, ac = q2 - x, ad = q3 - x;
-    const P3 n1 = ad.cross(ac), n2 = ab.cross(ad), n3 = ac.cross(ab);
-    const double v6 = -ab.dot(n1);
-    const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + l2_fixed) / 6.0;
-    if (l2 <= 0) return -2.0;
-    if (!(v6 > 0 && 2.0 * v6 * v6 > 1e-18 * l2 * l2 * l2) || !(inv0 > 0))
-      return std::min(std::sqrt(2.0) * v6 / (l2 * std::sqrt(l2)), 0.0) - 1.0;
-    const double s1 = n1.squaredNorm(), s2 = n2.squaredNorm(), s3 = n3.squaredNorm();
-    if (!(s1 > 0 && s2 > 0 && s3 > 0)) return 0.0;
-    const double i1 = 1.0 / s1, i2 = 1.0 / s2, i3 = 1.0 / s3;
-    const auto term = [](double dd, double inv) { return dd * std::abs(dd) * inv; };
-    double best = term(-n0.dot(n1), inv0 * i1);
-    best = std::max(best, term(-n0.dot(n2), inv0 * i2));
-    best = std::max(best, term(-n0.dot(n3), inv0 * i3));
-    best = std::max(best, term(-n1.dot(n2), i1 * i2));
-    best = std::max(best, term(-n1.dot(n3), i1 * i3));
-    best = std::max(best, term(-n2.dot(n3), i2 * i3));
-    return 1.0 - std::clamp(best, -1.0, 1.0);
+  MovingTetLanes<N> lanes;
+  lanes.set_all(m);
+  for (int k = 0; k < n_points; k += N) {
+    lanes.rank(&at[0][k], &at[1][k], &at[2][k], &r[k]);
+    for (int l = 0; l < N; ++l)
+      if (std::isnan(r[k + l])) r[k + l] = m.rank(P3(at[0][k + l], at[1][k + l], at[2][k + l]));
   }
-};
+  P3 g;
+  for (int d = 0; d < 3; ++d) g[d] = (r[2 * d] - r[2 * d + 1]) / (2 * h);
+  return g;
+}
+
+/// The worst rank over `local` at x, N at a time (blocks: `local` in lanes), into trial; some
+/// value <= bound as soon as one is. The block of `first` (the one likeliest to fail) is tried
+/// first, and `first` becomes the one that failed. Without an early stop, trial[i] holds every
+/// rank at x.
+template <int N>
+[[gnu::always_inline]] inline double lanes_worst_above(const std::vector<MovingTet>& local, const MovingTetLanes<N>* blocks,
+                                                       double* trial, const P3& x, double bound, std::int32_t& first) {
+  const std::int32_t n = static_cast<std::int32_t>(local.size());
+  const std::int32_t n_blocks = (n + N - 1) / N;
+  double at[3][N];
+  for (int c = 0; c < 3; ++c)
+    for (int l = 0; l < N; ++l) at[c][l] = x[c];
+  const std::int32_t b0 = first / N;
+  double w = std::numeric_limits<double>::infinity();
+  for (std::int32_t j = 0; j < n_blocks; ++j) {
+    const std::int32_t b = j == 0 ? b0 : j <= b0 ? j - 1 : j;
+    double r[N];
+    blocks[b].rank(at[0], at[1], at[2], r);
+    std::int32_t failed = -1;
+    for (std::int32_t l = 0; l < N && N * b + l < n; ++l) {
+      const std::int32_t i = N * b + l;
+      trial[i] = std::isnan(r[l]) ? local[i].rank(x) : r[l];
+      w = std::min(w, trial[i]);
+      if (failed < 0 && trial[i] <= bound) failed = i;
+    }
+    if (failed >= 0) {
+      first = failed;
+      return w;
+    }
+  }
+  return w;
+}
+
+// Four lanes in AVX registers where the CPU has them (AVX without FMA: SSE2's roundings).
+// MovingTetLanes<4>'s vector helpers are all inlined into the AVX functions; GCC and Clang still
+// warn (GCC at the end of the file) that their four-double arguments would change the ABI.
+#if defined(__GNUC__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define FEBEMESH_TARGET_AVX [[gnu::target("avx")]]
+bool has_avx() { return __builtin_cpu_supports("avx"); }
+#else
+#define FEBEMESH_TARGET_AVX
+bool has_avx() { return false; }
+#endif
+FEBEMESH_TARGET_AVX P3 lanes_gradient_avx(const MovingTet& m, const P3& x, double h) { return lanes_gradient<4>(m, x, h); }
+FEBEMESH_TARGET_AVX double lanes_worst_above_avx(const std::vector<MovingTet>& local, const MovingTetLanes<4>* blocks,
+                                                 double* trial, const P3& x, double bound, std::int32_t& first) {
+  return lanes_worst_above<4>(local, blocks, trial, x, bound, first);
+}
+#undef FEBEMESH_TARGET_AVX
 
 constexpr int max_tangent_planes = 3;
 constexpr int max_tangent_candidates = max_tangent_planes * 3 * 2;
@@ -116,9 +152,13 @@ struct Optimizer {
   std::vector<double> tet_q;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
   double tangent_rank = 0.0;  ///< angle_rank of opt.tangent_below_deg
+  bool avx = has_avx();  ///< rank four lanes at a time in AVX registers
   /// One thread's working space for relax.
   struct alignas(64) Scratch {
     std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
+    /// The same in blocks of lanes (the last one padded with copies): fours with AVX, else pairs.
+    std::vector<MovingTetLanes<4>> quads;
+    std::vector<MovingTetLanes<2>> pairs;
     std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
     std::size_t moves = 0;
   };
@@ -176,33 +216,14 @@ struct Optimizer {
     }
     return w;
   }
-  static P3 gradient(const MovingTet& m, const P3& x, double h) {
-    P3 g;
-    for (int d = 0; d < 3; ++d) {
-      P3 xp = x, xm = x;
-      xp[d] += h;
-      xm[d] -= h;
-      g[d] = (m.rank(xp) - m.rank(xm)) / (2 * h);
-    }
-    return g;
+  P3 gradient(const MovingTet& m, const P3& x, double h) const {
+    return avx ? lanes_gradient_avx(m, x, h) : lanes_gradient<2>(m, x, h);
   }
-  /// worst_above over sc.local (relax's incident tetrahedra).
-  /// Without an early stop, sc.trial[i] holds every incident tetrahedron's rank at x.
-  static double local_worst_above(Scratch& sc, const P3& x, double bound, std::int32_t& first) {
-    const std::vector<MovingTet>& local = sc.local;
-    std::vector<double>& trial = sc.trial;
-    const std::int32_t n = static_cast<std::int32_t>(local.size());
-    double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t j = 0; j < n; ++j) {
-      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
-      trial[i] = local[i].rank(x);
-      w = std::min(w, trial[i]);
-      if (w <= bound) {
-        first = i;
-        return w;
-      }
-    }
-    return w;
+  /// local in blocks of lanes, the last one padded with copies of the last tetrahedron.
+  template <int N> static void fill_blocks(const std::vector<MovingTet>& local, std::vector<MovingTetLanes<N>>& blocks) {
+    blocks.resize((local.size() + N - 1) / N);
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      for (std::size_t l = 0; l < N; ++l) blocks[k].set_lane(static_cast<int>(l), local[std::min(N * k + l, local.size() - 1)]);
   }
   /// Escobar et al.'s untangling objective of tetrahedron t with v at x: |S|^2 / (3 h(s)^(2/3)),
   /// S its Jacobian against the regular tetrahedron of edge `scale`, s = det S and
@@ -408,6 +429,10 @@ struct Optimizer {
     trial.resize(local.size());
     best_ranks.resize(local.size());
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) local[k - start[v]].set(tets[incident[k]], v, mesh.points);
+    if (avx)
+      fill_blocks(local, sc.quads);
+    else
+      fill_blocks(local, sc.pairs);
     std::array<P3, 2> dirs;
     int n_dirs = 0;
     const P3 g = gradient(local[worst_local], x0, h);
@@ -452,7 +477,8 @@ struct Optimizer {
       P3 x;
       BoundaryLocation w;
       place(v, x0, c, x, w);
-      double f = local_worst_above(sc, x, best + 1e-12, worst_local);
+      double f = avx ? lanes_worst_above_avx(local, sc.quads.data(), trial.data(), x, best + 1e-12, worst_local)
+                     : lanes_worst_above<2>(local, sc.pairs.data(), trial.data(), x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
       if (f > best + 1e-12) best = f, best_x = x, best_w = w, best_ranks.swap(trial);
     }

@@ -52,6 +52,43 @@ TEST_CASE("closest point matches brute force", "[aabb_tree][property]") {
   });
 }
 
+TEST_CASE("closest point with a hint is closest point without", "[aabb_tree]") {
+  // The same triangle and bits whatever the hint: the hint only bounds the search. Points near
+  // the surface (as the tet optimiser asks: the answer's neighbours and far triangles as hints)
+  // and far from it, among them vertices and points straight out of them (ties between the
+  // triangles around a vertex, which the tree order breaks).
+  const Surface& s = elephant();
+  const AabbTree tree(s.vertices(), s.triangles());
+  const double diag = s.bounding_box().extent().norm();
+  std::uint64_t seed = 8;
+  const auto uniform = [&] {
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(seed >> 11) / double(1ULL << 53);
+  };
+  int n_checked = 0;
+  for (int i = 0; i < 3000; ++i) {
+    P3 p;
+    const std::int32_t t0 = static_cast<std::int32_t>(uniform() * s.n_triangles());
+    const P3 n = s.normal(t0);
+    switch (i % 3) {
+      case 0: p = s.vertex(s.triangle(t0)[0]) + (uniform() - 0.3) * 0.01 * diag * n; break;
+      case 1: p = (s.vertex(s.triangle(t0)[0]) + s.vertex(s.triangle(t0)[1]) + s.vertex(s.triangle(t0)[2])) / 3.0 +
+                  (uniform() - 0.5) * 0.02 * diag * P3(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5); break;
+      default: p = point_near(s.bounding_box(), int(uniform() * 1000), int(uniform() * 1000), int(uniform() * 1000));
+    }
+    const AabbTree::Closest want = tree.closest(p);
+    for (const std::int32_t hint : {want.triangle, t0, static_cast<std::int32_t>(uniform() * s.n_triangles()),
+                                    std::int32_t{-1}, std::int32_t{s.n_triangles()}}) {
+      const AabbTree::Closest got = tree.closest(p, hint);
+      REQUIRE(got.triangle == want.triangle);
+      REQUIRE(got.distance2 == want.distance2);
+      REQUIRE(got.where.point == want.where.point);
+      ++n_checked;
+    }
+  }
+  CHECK(n_checked == 15000);
+}
+
 TEST_CASE("closest point regions on a single triangle", "[aabb_tree]") {
   const P3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
   CHECK(closest_on_triangle(P3(0.2, 0.2, 1), a, b, c).region == TriangleRegion::Face);
