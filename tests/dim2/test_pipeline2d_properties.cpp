@@ -128,9 +128,13 @@ TEST_CASE("the FE area approaches the exact area as the level rises", "[property
       for (std::size_t l = 0; l < curve.loops().size(); ++l) perimeter += curve.length(int(l));
     }
     std::vector<double> err, haus;
+    int finest = 0;  // the first tree's finest leaf level
+    const int level0 = c.domain.level;
     for (int k = 0; k < 3; ++k) {
       const test::PipelineOutcome out = run_case(c, tally);
       RC_ASSERT(out.v.valid);
+      if (k == 0)
+        for (std::size_t i = 0; i < out.r.tree.n_leaves(); ++i) finest = std::max(finest, int(out.r.tree.leaf(i).level));
       err.push_back(out.f.area_rel_error);
       haus.push_back(out.f.hausdorff);
       // The region between the BE polygon and the curve lies within the Hausdorff distance of
@@ -141,10 +145,16 @@ TEST_CASE("the FE area approaches the exact area as the level rises", "[property
     RC_LOG() << "area errors " << err[0] << " " << err[1] << " " << err[2] << ", Hausdorff " << haus[0] << " "
              << haus[1] << " " << haus[2] << "\n";
     // The signed area error is not monotone (chords inside convex parts and outside concave ones
-    // cancel: 777006 found 2.6e-6, 3.9e-6, 5.3e-6 at levels 6-8), and the file's own levels can
-    // fix the finest cells; two more levels still halve the cells everywhere, so the distance
-    // that bounds it falls.
-    RC_ASSERT(haus[2] < haus[0]);
+    // cancel: 777006 found 2.6e-6, 3.9e-6, 5.3e-6 at levels 6-8), but the distance that bounds it
+    // never grows over two levels, and falls when they make every cell finer. Not where the
+    // first tree already has cells two levels finer (the file's levels, or bends tighter than
+    // the cells, refined whatever level was asked): there the largest distance can stay put
+    // (session 12, 2000 cases at seed 31, case 805: a hole of radius 0.09 with two corners kept
+    // cells of level 9 or finer at its bends, Hausdorff 8.67487e-5 at levels 6, 7 and 8, then
+    // 2.63e-5 at 9).
+    RC_LOG() << "finest leaf level " << finest << " at level " << level0 << "\n";
+    RC_ASSERT(haus[2] <= haus[0]);
+    if (finest < level0 + 2) RC_ASSERT(haus[2] < haus[0]);
   });
   tally.print("area convergence");
 }
