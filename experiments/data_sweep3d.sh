@@ -27,11 +27,10 @@ for s in $surfaces; do
       rm -rf "$d"
       /usr/bin/time -f "%U %S %M" -o "$d.time" "$bin" mesh3d "$data/3d/$s.off" -o "$d" --level "$level" \
         --elements "$kind" --threads "$threads" --allow-invalid >/dev/null 2>"$d.err"
-      rc=$?
       read -r user sys peak_kb < <(tail -n 1 "$d.time")
-      python3 - "$d/report.json" "$s" "$level" "$kind" "$rc" "$user" "$sys" "$peak_kb" "$d.err" <<'PY'
+      python3 - "$d/report.json" "$s" "$level" "$kind" "$user" "$sys" "$peak_kb" "$d.err" <<'PY'
 import json, os, sys
-path, s, level, kind, rc, user, sys_t, peak_kb, err = sys.argv[1:]
+path, s, level, kind, user, sys_t, peak_kb, err = sys.argv[1:]
 cpu = float(user) + float(sys_t)
 mb = int(peak_kb) / 1024
 if not os.path.exists(path):
