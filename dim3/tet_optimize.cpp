@@ -188,34 +188,6 @@ struct Optimizer {
     for (int k = 0; k < 4; ++k) p[k] = tets[t][k] == v ? x : mesh.points[tets[t][k]];
     return tet_search_rank(p[0], p[1], p[2], p[3]);
   }
-  double worst_at(std::int32_t v, const P3& x, std::int32_t* which = nullptr) const {
-    double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
-      const double q = quality_at(incident[k], v, x);
-      if (q < w) {
-        w = q;
-        if (which) *which = incident[k];
-      }
-    }
-    return w;
-  }
-  /// Like worst_at, but stops as soon as one tetrahedron is at or below `bound` (the answer
-  /// is then some value <= bound). The incident tetrahedron `first` (an index into them, the one
-  /// likeliest to fail) is tried first and becomes the one that failed; the order changes only
-  /// which value <= bound is returned, never whether one is.
-  double worst_above(std::int32_t v, const P3& x, double bound, std::int32_t& first) const {
-    const std::int32_t n = start[v + 1] - start[v];
-    double w = std::numeric_limits<double>::infinity();
-    for (std::int32_t j = 0; j < n; ++j) {
-      const std::int32_t i = j == 0 ? first : j <= first ? j - 1 : j;
-      w = std::min(w, quality_at(incident[start[v] + i], v, x));
-      if (w <= bound) {
-        first = i;
-        return w;
-      }
-    }
-    return w;
-  }
   P3 gradient(const MovingTet& m, const P3& x, double h) const {
     return avx ? lanes_gradient_avx(m, x, h) : lanes_gradient<2>(m, x, h);
   }
