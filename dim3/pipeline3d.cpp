@@ -833,11 +833,11 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         if (!v.valid) problems = std::move(*folds_pending);
-      }
-      if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
+      } else if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
-        // what the max-min untangling alone would have done, refine around its problems.
+        // what the max-min untangling alone would have done, refine around its problems. Not
+        // after the validation above, whose checks include these.
         say("untangling (Escobar objective): the mesh does not conform; refining instead");
         problems = std::move(*before_escobar);
       }
