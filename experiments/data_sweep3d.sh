@@ -6,7 +6,10 @@
 # refused run the first words of its reason. open-cylinder.off is left out (it must be refused,
 # tests/cli checks that).
 # Usage: experiments/data_sweep3d.sh [BUILD_DIR] [OUT_DIR]
-#   LEVELS="4 5 6" KINDS="tet hex" SURFACES="sphere966 anchor" THREADS=1 narrow it down.
+#   LEVELS="4 5 6" KINDS="tet hex" SURFACES="sphere966 anchor" THREADS=1 narrow it down;
+#   KEEP=0 removes each run's folder once its row is printed (level 6 meshes are 0.1-1 GB);
+#   the exit status is 1 when any run is not valid (the regression test dim3_data_levels,
+#   tests/CMakeLists.txt, runs it at levels 4-6 in both kinds).
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build}/febemesh
@@ -15,9 +18,11 @@ data=${FEBEMESH_DATA_DIR:-"$root/../shared/data"}
 levels=${LEVELS:-"4 5 6"}
 kinds=${KINDS:-"tet"}
 threads=${THREADS:-1}
+keep=${KEEP:-1}
 surfaces=${SURFACES:-$(cd "$data/3d" && ls *.off | grep -v '^open-' | sed 's/\.off$//' | tr '\n' ' ')}
 [ -x /usr/bin/time ] || { echo "data_sweep3d: needs GNU time (/usr/bin/time)" >&2; exit 1; }
 mkdir -p "$out"
+failed=0
 echo "| surface | level | kind | status | elements | tets | min dihedral (deg) | volume error | Hausdorff / diag | CPU s | peak MB | note |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for s in $surfaces; do
@@ -28,7 +33,7 @@ for s in $surfaces; do
       /usr/bin/time -f "%U %S %M" -o "$d.time" "$bin" mesh3d "$data/3d/$s.off" -o "$d" --level "$level" \
         --elements "$kind" --threads "$threads" --allow-invalid >/dev/null 2>"$d.err"
       read -r user sys peak_kb < <(tail -n 1 "$d.time")
-      python3 - "$d/report.json" "$s" "$level" "$kind" "$user" "$sys" "$peak_kb" "$d.err" <<'PY'
+      python3 - "$d/report.json" "$s" "$level" "$kind" "$user" "$sys" "$peak_kb" "$d.err" <<'PY' > "$d.row"
 import json, os, sys
 path, s, level, kind, user, sys_t, peak_kb, err = sys.argv[1:]
 cpu = float(user) + float(sys_t)
@@ -46,6 +51,10 @@ status = "valid" if v["valid"] else "invalid"
 print(f"| {s} | {level} | {kind} | {status} | {q['n_elements']} | {c['tetrahedra']} | {q['min_dihedral_deg']:.2f} | "
       f"{100 * f['volume_rel_error']:.2f}% | {f['hausdorff_rel']:.2e} | {cpu:.1f} | {mb:.0f} | {', '.join(notes)} |")
 PY
+      grep -q "| valid |" "$d.row" || failed=1
+      cat "$d.row"
+      [ "$keep" = 0 ] && rm -rf "$d" "$d.time" "$d.err" "$d.row"
     done
   done
 done
+exit $failed
