@@ -34,6 +34,9 @@ struct HexDominantOptions {
   double min_hex_scaled_jacobian = 0.2;
   /// A pyramid below this scaled Jacobian and below its two cones' stays two tets.
   double min_pyramid_scaled_jacobian = 0.2;
+  /// A pyramid or hex whose smallest dihedral angle is below this and below the smallest of the
+  /// tets it would replace stays tets (pyramids). 0 = no dihedral rule.
+  double min_dihedral_deg = 15.0;
 };
 
 struct HexDominantStats {
