@@ -17,7 +17,9 @@
 //   as apex (the union of its two cones), every other face triangle stays a Tet4;
 // - a quad face is split back into its two triangles, on both sides, when a pyramid on it has a
 //   non-positive corner Jacobian, or a scaled Jacobian below both min_pyramid_scaled_jacobian
-//   and its two cones', or when it is not seen as a quad by both cells; a hex with a split face
+//   and its two cones', or when the pyramids on it (both sides) have a smallest dihedral angle
+//   below both min_dihedral_deg and their cones' (a hex likewise against its cones; warped
+//   quads), or when it is not seen as a quad by both cells; a hex with a split face
 //   becomes pyramids. Repeated until nothing changes (splits only grow), so every
 //   shared face is the same quad or the same two triangles on both sides.
 
