@@ -299,15 +299,23 @@ struct Optimizer {
   void build_neighbours() {
     const std::size_t n = mesh.points.size();
     nb_start.assign(n + 1, 0);
-    std::vector<std::int32_t> tmp;
+    // The distinct neighbours by marks (seen[u] == v), then sorted: the lists of sorting all
+    // ~70 uses a node's tetrahedra make and keeping one of each (97 M instructions, sphere966
+    // L5, of which the sort most).
+    std::vector<std::int32_t> seen(n, -1);
     for (std::size_t v = 0; v < n; ++v) {
-      tmp.clear();
+      const auto self = static_cast<std::int32_t>(v);
+      const std::size_t first = nbs.size();
       for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
         for (std::int32_t u : tets[incident[k]])
-          if (u != static_cast<std::int32_t>(v)) tmp.push_back(u);
-      std::sort(tmp.begin(), tmp.end());
-      tmp.erase(std::unique(tmp.begin(), tmp.end()), tmp.end());
-      nbs.insert(nbs.end(), tmp.begin(), tmp.end());
+          if (u != self && seen[u] != self) seen[u] = self, nbs.push_back(u);
+      const auto lo = nbs.begin() + static_cast<std::ptrdiff_t>(first), hi = nbs.end();
+      if (hi - lo > 32) {
+        std::sort(lo, hi);
+      } else {
+        for (auto i = lo + (lo != hi); i < hi; ++i)
+          for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+      }
       nb_start[v + 1] = static_cast<std::int32_t>(nbs.size());
     }
   }
