@@ -68,9 +68,11 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
       if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
         const int m = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
         for (int i = 0; i < m; ++i) edge(nodes[i].v, nodes[i + 1 == m ? (m == 1 ? 1 : 0) : i + 1].v);
-      } else if (t == ElemType::Tet4) {  // every pair
-        for (int i = 0; i < 3; ++i)
-          for (int j = i + 1; j < 4; ++j) edge(nodes[i].v, nodes[j].v);
+      } else if (t == ElemType::Tet4) {  // every pair: v's are those of v's places, with each other node
+        for (int i = 0; i < 4; ++i)
+          if (nodes[i].v == v)
+            for (int j = 0; j < 4; ++j)
+              if (j != i) visit(nodes[j].v);
       } else {
         for (int e = 0; e < n_edges(t); ++e) {
           const auto [a, b] = edge_local_nodes(t, e);
