@@ -3,6 +3,7 @@
 #include "core/mesh_topology.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 
 #include "core/error.hpp"
@@ -148,12 +149,8 @@ int orientation_of(const Facet& f) {
 
 namespace {
 
-/// Every facet use in generation order: (element, local facet) increasing.
-std::vector<FacetUse> unsorted_uses(const Elements& els) {
-  std::vector<FacetUse> uses;
-  std::size_t total = 0;
-  for (std::size_t e = 0; e < els.size(); ++e) total += static_cast<std::size_t>(n_facets(els.type[e]));
-  uses.reserve(total);
+/// Calls visit(use) for every facet use in generation order: (element, local facet) increasing.
+template <class Visit> void each_facet_use(const Elements& els, Visit&& visit) {
   for (std::size_t e = 0; e < els.size(); ++e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     const ElemType t = els.type[e];
@@ -166,30 +163,44 @@ std::vector<FacetUse> unsorted_uses(const Elements& els) {
         const std::int32_t a = v[f].v, b = v[f + 1 == n ? 0 : f + 1].v;
         FacetUse u{FacetKey{}, id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(a < b ? 1 : -1)};
         u.key.v[0] = std::min(a, b), u.key.v[1] = std::max(a, b);
-        uses.push_back(u);
+        visit(u);
       }
       continue;
     }
     for (int f = 0; f < n_facets(t); ++f) {
       const Facet fc = facet_of(els, id, f);
-      uses.push_back({key_of(fc), id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(orientation_of(fc))});
+      visit(FacetUse{key_of(fc), id, static_cast<std::int8_t>(f), static_cast<std::int8_t>(orientation_of(fc))});
     }
   }
+}
+
+/// Every facet use in generation order.
+std::vector<FacetUse> unsorted_uses(const Elements& els) {
+  std::vector<FacetUse> uses;
+  std::size_t total = 0;
+  for (std::size_t e = 0; e < els.size(); ++e) total += static_cast<std::size_t>(n_facets(els.type[e]));
+  uses.reserve(total);
+  each_facet_use(els, [&](const FacetUse& u) { uses.push_back(u); });
   return uses;
 }
 
-/// Stable counting sort of `items` by bucket(item) in [0, n_buckets); `start` receives the
-/// bucket boundaries (n_buckets + 1 entries).
-template <class T, class Bucket>
-std::vector<T> bucket_sort(const std::vector<T>& items, std::size_t n_buckets, Bucket bucket,
-                           std::vector<std::size_t>& start) {
-  start.assign(n_buckets + 1, 0);
-  for (const T& x : items) ++start[bucket(x) + 1];
-  for (std::size_t b = 0; b < n_buckets; ++b) start[b + 1] += start[b];
-  std::vector<T> out(items.size());
-  std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-  for (const T& x : items) out[fill[bucket(x)]++] = x;
-  return out;
+/// Calls visit(smallest node) for every facet use (in no particular order within an element):
+/// facet_uses' bucket counts without building the keys.
+template <class Visit> void each_facet_smallest(const Elements& els, Visit&& visit) {
+  for (std::size_t e = 0; e < els.size(); ++e) {
+    const ElemType t = els.type[e];
+    const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+    if (t == ElemType::Tet4) {  // the four facets are the four triples
+      const std::int32_t a = v[0].v, b = v[1].v, c = v[2].v, d = v[3].v;
+      visit(std::min({b, c, d})), visit(std::min({a, c, d})), visit(std::min({a, b, d})), visit(std::min({a, b, c}));
+      continue;
+    }
+    for (int f = 0; f < n_facets(t); ++f) {
+      std::int32_t m = std::numeric_limits<std::int32_t>::max();
+      for (const int k : facet_local_nodes(t, f)) m = std::min(m, v[k].v);
+      visit(m);
+    }
+  }
 }
 
 /// Stable sort of the short range [first, last) (a bucket: the uses or edges of one node).
@@ -207,15 +218,21 @@ template <class It, class Less> void sort_bucket(It first, It last, Less less) {
 // Cost: the uses are generated in (element, local facet) order, so a stable counting sort by the
 // smallest node followed by a stable sort of each node's few uses by the remaining key gives the
 // (key, element, local) order in linear time (facet_uses_ref: one comparison sort, same order).
+// The counting pass reads only the smallest nodes, and the uses go straight to their buckets:
+// no unsorted copy (24 B a use, 96 B a tetrahedron, beside the sorted one at the heap peak).
 std::vector<FacetUse> facet_uses(const Elements& els) {
-  const std::vector<FacetUse> uses = unsorted_uses(els);
-  std::int64_t top = -1;
-  for (const FacetUse& u : uses) top = std::max<std::int64_t>(top, u.key.v[0]);
+  std::int64_t top = -1;  // any bound on the smallest ids will do: the largest node
+  for (const VertexId v : els.node) top = std::max<std::int64_t>(top, v.v);
   // Ids are >= -1: bucket = smallest id + 1.
-  std::vector<std::size_t> start;
-  std::vector<FacetUse> sorted = bucket_sort(uses, static_cast<std::size_t>(top + 2),
-                                             [](const FacetUse& u) { return static_cast<std::size_t>(u.key.v[0] + 1); },
-                                             start);
+  const std::size_t n_buckets = static_cast<std::size_t>(top + 2);
+  std::vector<std::size_t> start(n_buckets + 1, 0);
+  each_facet_smallest(els, [&](std::int32_t m) { ++start[static_cast<std::size_t>(m + 1) + 1]; });
+  for (std::size_t b = 0; b < n_buckets; ++b) start[b + 1] += start[b];
+  std::vector<FacetUse> sorted(start[n_buckets]);
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    each_facet_use(els, [&](const FacetUse& u) { sorted[fill[static_cast<std::size_t>(u.key.v[0] + 1)]++] = u; });
+  }
   for (std::size_t b = 0; b + 1 < start.size(); ++b)
     sort_bucket(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
                 sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]), [](const FacetUse& x, const FacetUse& y) {
@@ -413,20 +430,60 @@ std::vector<std::array<VertexId, 2>> edge_list(const Elements& els) {
 
 }  // namespace
 
-// Cost: linear, a counting sort by the smaller node then each node's few edges sorted.
+// Cost: linear, a counting sort by the smaller node then each node's few edges sorted. Memory:
+// the larger node of each use (4 B; the list of pairs and its sorted copy were 8 B each, and the
+// result kept the copy's capacity: 48 B a tetrahedron for the rest of a validation), then the
+// result at its exact size.
 std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els) {
-  const std::vector<std::array<VertexId, 2>> edges = edge_list(els);
+  // Calls visit(smaller, larger) for every edge use (tetrahedra: every pair, in any order; the
+  // result is sorted).
+  const auto each_edge = [&](auto&& visit) {
+    for (std::size_t e = 0; e < els.size(); ++e) {
+      const VertexId* nodes = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+      const ElemType t = els.type[e];
+      const auto edge = [&](std::int32_t u, std::int32_t w) { u < w ? visit(u, w) : visit(w, u); };
+      if (t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
+        const int n = t == ElemType::Tri3 ? 3 : 4;
+        for (int k = 0; k < n; ++k) edge(nodes[k].v, nodes[k + 1 == n ? 0 : k + 1].v);
+      } else if (t == ElemType::Tet4) {
+        for (int a = 0; a < 3; ++a)
+          for (int b = a + 1; b < 4; ++b) edge(nodes[a].v, nodes[b].v);
+      } else {
+        for (int k = 0; k < n_edges(t); ++k) {
+          const auto [a, b] = edge_local_nodes(t, k);
+          edge(nodes[a].v, nodes[b].v);
+        }
+      }
+    }
+  };
   std::int64_t top = -1;
-  for (const auto& e : edges) top = std::max<std::int64_t>(top, e[0].v);
-  std::vector<std::size_t> start;
-  std::vector<std::array<VertexId, 2>> sorted = bucket_sort(
-      edges, static_cast<std::size_t>(top + 2), [](const auto& e) { return static_cast<std::size_t>(e[0].v + 1); }, start);
-  for (std::size_t b = 0; b + 1 < start.size(); ++b)
-    sort_bucket(sorted.begin() + static_cast<std::ptrdiff_t>(start[b]),
-                sorted.begin() + static_cast<std::ptrdiff_t>(start[b + 1]),
-                [](const auto& x, const auto& y) { return x[1].v < y[1].v; });
-  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
-  return sorted;
+  for (const VertexId v : els.node) top = std::max<std::int64_t>(top, v.v);
+  // Ids are >= -1: bucket = smaller id + 1.
+  const std::size_t n_buckets = static_cast<std::size_t>(top + 2);
+  std::vector<std::size_t> start(n_buckets + 1, 0);
+  each_edge([&](std::int32_t u, std::int32_t) { ++start[static_cast<std::size_t>(u + 1) + 1]; });
+  for (std::size_t b = 0; b < n_buckets; ++b) start[b + 1] += start[b];
+  std::vector<std::int32_t> larger(start[n_buckets]);
+  {
+    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
+    each_edge([&](std::int32_t u, std::int32_t w) { larger[fill[static_cast<std::size_t>(u + 1)]++] = w; });
+  }
+  // Each bucket sorted and deduplicated in place, to the front of its range.
+  std::size_t total = 0;
+  std::vector<std::size_t> end(n_buckets);
+  for (std::size_t b = 0; b < n_buckets; ++b) {
+    const auto first = larger.begin() + static_cast<std::ptrdiff_t>(start[b]),
+               last = larger.begin() + static_cast<std::ptrdiff_t>(start[b + 1]);
+    sort_bucket(first, last, std::less<>{});
+    end[b] = start[b] + static_cast<std::size_t>(std::unique(first, last) - first);
+    total += end[b] - start[b];
+  }
+  std::vector<std::array<VertexId, 2>> edges;
+  edges.reserve(total);
+  for (std::size_t b = 0; b < n_buckets; ++b)
+    for (std::size_t i = start[b]; i < end[b]; ++i)
+      edges.push_back({VertexId{static_cast<std::int32_t>(b) - 1}, VertexId{larger[i]}});
+  return edges;
 }
 
 namespace {

@@ -26,67 +26,6 @@ struct Csr {
   }
 };
 
-/// Node -> its distinct edge neighbours in `els`, ascending: the lists the pairs of
-/// unique_edges(els) taken both ways gave (an edge (v, v) of a degenerate element lists v
-/// twice there, and here). Built by counting, without the edge and pair lists (memory peak).
-/// With `once`, sets once[v] = 1 for the nodes of the edges that one element uses, which the
-/// sorted lists count on the way: for triangles and quads, whose facets are their edges, the
-/// nodes of boundary_facets(els).
-Csr edge_neighbours(std::size_t n, const Elements& els, std::vector<std::uint8_t>* once = nullptr) {
-  Csr g;
-  g.start.assign(n + 1, 0);
-  auto each_edge = [&](auto&& visit) {
-    for (std::size_t e = 0; e < els.size(); ++e) {
-      const VertexId* nodes = els.nodes(ElemId{static_cast<std::int32_t>(e)});
-      const ElemType t = els.type[e];
-      if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
-        const int n = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
-        for (int k = 0; k < n; ++k) visit(nodes[k].v, nodes[k + 1 == n ? (n == 1 ? 1 : 0) : k + 1].v);
-        continue;
-      }
-      for (int k = 0; k < n_edges(els.type[e]); ++k) {
-        const auto [a, b] = edge_local_nodes(els.type[e], k);
-        visit(nodes[a].v, nodes[b].v);
-      }
-    }
-  };
-  each_edge([&](std::int32_t u, std::int32_t w) { ++g.start[u + 1], ++g.start[w + 1]; });
-  for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
-  g.item.resize(g.start[n]);
-  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
-  each_edge([&](std::int32_t u, std::int32_t w) { g.item[fill[u]++] = w, g.item[fill[w]++] = u; });
-  fill = {};
-  // Sort and deduplicate each node's list, compacting in place (a list only shrinks).
-  std::int32_t out = 0, begin = 0;
-  for (std::size_t v = 0; v < n; ++v) {
-    const std::int32_t end = g.start[v + 1];
-    auto first = g.item.begin() + begin, last = g.item.begin() + end;
-    if (last - first > 32) {
-      std::sort(first, last);
-    } else {
-      for (auto i = first + (first != last); i < last; ++i)
-        for (auto j = i; j != first && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
-    }
-    // One pass over the sorted list: each run's value once (v itself twice: an edge (v, v)
-    // lists v twice per use), the runs of a single use flagging v for `once`.
-    const auto self = static_cast<std::int32_t>(v);
-    g.start[v] = out;
-    for (auto it = first; it != last;) {
-      auto run = it + 1;
-      while (run != last && *run == *it) ++run;
-      if (once && run - it == (*it == self ? 2 : 1)) (*once)[v] = 1;
-      g.item[out++] = *it;  // out never passes it: lists only shrink, and v's run has two entries
-      if (*it == self) g.item[out++] = *it;
-      it = run;
-    }
-    begin = end;
-  }
-  g.start[n] = out;
-  g.item.resize(static_cast<std::size_t>(out));
-  g.item.shrink_to_fit();
-  return g;
-}
-
 /// Node -> the elements that use it, in increasing order (once per use).
 Csr incident_elements(std::size_t n, const Elements& els) {
   Csr g;
@@ -98,6 +37,93 @@ Csr incident_elements(std::size_t n, const Elements& els) {
   for (std::size_t e = 0; e < els.size(); ++e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     for (int i = 0; i < els.n_nodes_of(id); ++i) g.item[fill[els.nodes(id)[i].v]++] = id.v;
+  }
+  return g;
+}
+
+/// Node -> its distinct edge neighbours in `els`, ascending: the lists the pairs of
+/// unique_edges(els) taken both ways gave (an edge (v, v) of a degenerate element lists v
+/// twice there, and here). Built node by node from `incident` (incident_elements(n, els)), each
+/// list by marks (seen[w] == v) and then sorted, counted first so that the array has its exact
+/// size: the list of every edge use both ways, 48 B a tetrahedron, was the 3D pipeline's heap
+/// peak (sphere966 L5, heaptrack), and sorting each node's ~70 uses 247 M of the CLI's 8.2 G
+/// instructions (callgrind). With `once`, sets once[v] = 1 for the nodes of the edges that one
+/// element uses: for triangles and quads, whose facets are their edges, the nodes of
+/// boundary_facets(els).
+Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr) {
+  Csr g;
+  g.start.assign(n + 1, 0);
+  // Calls visit(w) for every edge (v, w) of v's elements, once per edge use ((v, v): twice).
+  auto each_use = [&](std::int32_t v, auto&& visit) {
+    const auto elems = incident.of(v);
+    for (std::size_t k = 0; k < elems.size(); ++k) {
+      if (k > 0 && elems[k] == elems[k - 1]) continue;  // an element using v twice: its edges once
+      const ElemId id{elems[k]};
+      const VertexId* nodes = els.nodes(id);
+      const ElemType t = els.type[static_cast<std::size_t>(elems[k])];
+      const auto edge = [&](std::int32_t a, std::int32_t b) {
+        if (a == v) visit(b);
+        if (b == v) visit(a);
+      };
+      if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
+        const int m = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
+        for (int i = 0; i < m; ++i) edge(nodes[i].v, nodes[i + 1 == m ? (m == 1 ? 1 : 0) : i + 1].v);
+      } else if (t == ElemType::Tet4) {  // every pair: v's are those of v's places, with each other node
+        for (int i = 0; i < 4; ++i)
+          if (nodes[i].v == v)
+            for (int j = 0; j < 4; ++j)
+              if (j != i) visit(nodes[j].v);
+      } else {
+        for (int e = 0; e < n_edges(t); ++e) {
+          const auto [a, b] = edge_local_nodes(t, e);
+          edge(nodes[a].v, nodes[b].v);
+        }
+      }
+    }
+  };
+  std::vector<std::int32_t> seen(n, -1), uses;
+  if (once) uses.assign(n, 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto self = static_cast<std::int32_t>(v);
+    std::int32_t count = 0;
+    each_use(self, [&](std::int32_t w) {
+      if (seen[w] == self) return;
+      seen[w] = self;
+      count += w == self ? 2 : 1;  // v itself twice
+    });
+    g.start[v + 1] = g.start[v] + count;
+  }
+  g.item.resize(static_cast<std::size_t>(g.start[n]));
+  std::fill(seen.begin(), seen.end(), -1);
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto self = static_cast<std::int32_t>(v);
+    std::int32_t out = g.start[v];
+    bool has_self = false;
+    each_use(self, [&](std::int32_t w) {
+      if (once) ++uses[w];
+      if (seen[w] == self) return;
+      seen[w] = self;
+      has_self = has_self || w == self;
+      g.item[static_cast<std::size_t>(out++)] = w;
+    });
+    const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
+    if (hi - lo > 32) {
+      std::sort(lo, hi);
+    } else {
+      for (auto i = lo + (lo != hi); i < hi; ++i)
+        for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+    }
+    if (once) {
+      // A value of a single use flags v (v itself: one use lists it twice).
+      for (auto i = lo; i != hi; ++i)
+        if (uses[*i] == (*i == self ? 2 : 1)) (*once)[v] = 1;
+      for (auto i = lo; i != hi; ++i) uses[*i] = 0;
+    }
+    if (has_self) {  // v itself twice, as one value per run of the sorted uses gave it
+      const auto at = std::lower_bound(lo, hi, self) + 1;
+      std::copy_backward(at, hi, hi + 1);
+      *at = self;
+    }
   }
   return g;
 }
@@ -116,7 +142,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     return t == ElemType::Tri3 || t == ElemType::Quad4;
   });
   std::vector<std::uint8_t> on_boundary(n, 0);
-  const Csr neighbours = edge_neighbours(n, mesh.solid, polygons ? &on_boundary : nullptr);
+  const Csr incident = incident_elements(n, mesh.solid);
+  const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr);
   Elements boundary;
   const bool known = options.boundary_fixed && !options.project && options.fixed.size() == n;
   if (!polygons && !known) {
@@ -126,8 +153,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
       for (int i = 0; i < b.facet.n; ++i) on_boundary[b.facet.node[i].v] = 1;
     }
   }
-  const Csr boundary_neighbours = options.project ? edge_neighbours(n, boundary) : Csr{};
-  const Csr incident = incident_elements(n, mesh.solid);
+  const Csr boundary_neighbours = options.project ? edge_neighbours(n, boundary, incident_elements(n, boundary)) : Csr{};
 
   auto element_state = [&](std::int32_t e) {
     const ElemType type = mesh.solid.type[e];

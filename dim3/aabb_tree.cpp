@@ -98,8 +98,11 @@ AabbTree::Closest AabbTree::closest(const P3& p) const {
 AabbTree::Closest AabbTree::closest(const P3& p, std::int32_t hint) const {
   double bound = std::numeric_limits<double>::infinity();
   if (hint >= 0 && hint < n_triangles()) {
+    // The walk meets the hint's triangle again (usually the answer): its point is reused.
     const auto& q = points(hint);
-    bound = (closest_on_triangle(p, q[0], q[1], q[2]).point - p).squaredNorm() * (1.0 + 1e-9) + slack2_;
+    const TrianglePoint tp = closest_on_triangle(p, q[0], q[1], q[2]);
+    bound = (tp.point - p).squaredNorm() * (1.0 + 1e-9) + slack2_;
+    return closest_within(p, bound, [](std::int32_t) { return false; }, slot_[hint], &tp);
   }
   return closest_within(p, bound, [](std::int32_t) { return false; });
 }

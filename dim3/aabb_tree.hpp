@@ -70,8 +70,11 @@ class AabbTree {
   };
   void build(std::int32_t node, std::int32_t begin, std::int32_t end, const std::vector<P3>& centroids);
   /// closest_if visiting only boxes within `bound` (squared) of p, and only triangles whose
-  /// box is: the answer when it lies within the bound.
-  template <class Skip> Closest closest_within(const P3& p, double bound, Skip&& skip) const;
+  /// box is: the answer when it lies within the bound. The triangle in slot `known_slot` (-1:
+  /// none) has its closest point `known` already (the same numbers: not computed again).
+  template <class Skip>
+  Closest closest_within(const P3& p, double bound, Skip&& skip, std::int32_t known_slot = -1,
+                         const TrianglePoint* known = nullptr) const;
 
   std::vector<Node> nodes_;
   std::vector<std::int32_t> ids_;             ///< triangle index in slot order
@@ -88,7 +91,9 @@ template <class Skip> AabbTree::Closest AabbTree::closest_if(const P3& p, Skip&&
   return closest_within(p, std::numeric_limits<double>::infinity(), std::forward<Skip>(skip));
 }
 
-template <class Skip> AabbTree::Closest AabbTree::closest_within(const P3& p, double bound, Skip&& skip) const {
+template <class Skip>
+AabbTree::Closest AabbTree::closest_within(const P3& p, double bound, Skip&& skip, std::int32_t known_slot,
+                                           const TrianglePoint* known) const {
   Closest best;
   if (nodes_.empty()) return best;
   // Depth first, the nearer child first. A node is cut when its box is no nearer than the
@@ -123,7 +128,7 @@ template <class Skip> AabbTree::Closest AabbTree::closest_within(const P3& p, do
         if (skip(ids_[s])) continue;
         if (box_distance2(boxes_[s], p) > reach) continue;
         const auto& q = points_[s];
-        const TrianglePoint tp = closest_on_triangle(p, q[0], q[1], q[2]);
+        const TrianglePoint tp = s == known_slot ? *known : closest_on_triangle(p, q[0], q[1], q[2]);
         const double dist2 = (tp.point - p).squaredNorm();
         if (dist2 < best.distance2) best = {ids_[s], tp, dist2};
       }
