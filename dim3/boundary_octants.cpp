@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <tuple>
 
 #include "core/cube_faces.hpp"
@@ -287,10 +288,9 @@ bool first_hit(const SurfaceBoundary& s, const P3& q, const P3& end, P3& hit) {
 
 namespace {
 
-/// The paper's "other normals": rays from q along the outward normals of its free faces
-/// (`dirs`, bit f = face f) and along their sum; the first admissible surface point.
-bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q, std::uint8_t dirs, double reach,
-                    ClosestPoint<3>& out) {
+/// The paper's "other normals": the outward normals of a node's free faces (`dirs`, bit f =
+/// face f), their sum first.
+std::vector<P3> ray_directions(std::uint8_t dirs) {
   std::vector<P3> rays;
   P3 sum = P3::Zero();
   for (int f = 0; f < 6; ++f) {
@@ -306,7 +306,13 @@ bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q
     n[f / 2] = (f % 2) ? 1.0 : -1.0;
     rays.push_back(n);
   }
-  for (const P3& dir : rays) {
+  return rays;
+}
+
+/// The first admissible surface point along the rays from q in ray_directions(dirs).
+bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q, std::uint8_t dirs, double reach,
+                    ClosestPoint<3>& out) {
+  for (const P3& dir : ray_directions(dirs)) {
     P3 hit;
     if (!first_hit(s, q, q + reach * dir, hit)) continue;
     const ClosestPoint<3> cp = s.closest_point(hit);
@@ -316,6 +322,37 @@ bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q
     return true;
   }
   return false;
+}
+
+/// The worst cosine between the segment q..p and the outward normals of q's free faces (`dirs`,
+/// bit f = face f); 1 when p = q or q has no free face. Negative: the projection runs back
+/// against one of the faces, and the boundary octant of that face folds (diagnose3d "backward").
+double worst_outward(const P3& q, const P3& p, std::uint8_t dirs) {
+  const P3 d = p - q;
+  const double len = d.norm();
+  double worst = 1.0;
+  if (!(len > 0)) return worst;
+  for (int f = 0; f < Cube<3>::n_faces; ++f)
+    if ((dirs >> f) & 1) worst = std::min(worst, ((f % 2) ? 1.0 : -1.0) * d[f / 2] / len);
+  return worst;
+}
+
+/// Other surface points for node q than its closest: the next local minima of the distance
+/// (up to max_normals in all) and, with `rays`, the surface points along its free faces'
+/// normals and their sum (ray_directions) within `reach`.
+std::vector<ClosestPoint<3>> other_projections(const SurfaceBoundary& s, const P3& q, std::uint8_t dirs, double reach,
+                                               int max_normals, bool rays) {
+  std::vector<ClosestPoint<3>> out = s.closest_points(q, max_normals);
+  if (!out.empty()) out.erase(out.begin());
+  if (rays)
+    for (const P3& dir : ray_directions(dirs)) {
+      P3 hit;
+      if (!first_hit(s, q, q + reach * dir, hit)) continue;
+      ClosestPoint<3> c = s.closest_point(hit);
+      c.distance = (c.point - q).norm();
+      out.push_back(c);
+    }
+  return out;
 }
 
 /// Feature line segments bucketed on a uniform grid, for "nearest feature line point" queries.
@@ -511,6 +548,65 @@ void push_off_lines(const SurfaceBoundary& s, OctantComplex& oc, std::int32_t n_
   }
 }
 
+/// A surface node p whose projection runs back against a free face of one of its face nodes
+/// (worst_outward < 0) and folds cones of their boundary octants (folded_cones) moves to the
+/// candidate (other_projections of its face nodes, admissible from all of them, not another
+/// surface node's point) that folds fewest of those cones, if fewer (ties: the larger worst
+/// worst_outward). In node order, one at a time (a move changes its neighbours' octants), so
+/// the same for every thread count.
+void unfold_backward(const SurfaceBoundary& s, const Projector& proj, const std::vector<std::uint8_t>& node_dirs,
+                     const std::vector<double>& node_h, const BoundaryOctantOptions& opt,
+                     const std::vector<std::vector<std::int32_t>>& sources,
+                     std::map<std::tuple<double, double, double>, std::int32_t>& by_point, OctantComplex& oc,
+                     BoundaryOctantStats& stats) {
+  const std::int32_t n_lat = oc.n_lattice();
+  const std::int32_t n_pts = static_cast<std::int32_t>(oc.points.size());
+  std::vector<std::vector<std::int32_t>> octants_of(n_pts - n_lat);  // per surface node: its boundary octants
+  for (std::size_t k = 0; k < oc.boundary.size(); ++k)
+    for (const std::int32_t q : oc.boundary[k].ring) {
+      std::vector<std::int32_t>& list = octants_of[oc.projection[q] - n_lat];
+      if (list.empty() || list.back() != static_cast<std::int32_t>(k)) list.push_back(static_cast<std::int32_t>(k));
+    }
+  for (std::int32_t p = n_lat; p < n_pts; ++p) {
+    const std::vector<std::int32_t>& from = sources[p - n_lat];
+    const auto worst = [&](const P3& x) {
+      double w = 1.0;
+      for (const std::int32_t q : from) w = std::min(w, worst_outward(oc.points[q], x, node_dirs[q]));
+      return w;
+    };
+    const P3 old_point = oc.points[p];
+    double best_out = worst(old_point);
+    if (!(best_out < 0)) continue;
+    const auto folded = [&] {
+      int n = 0;
+      for (const std::int32_t k : octants_of[p - n_lat]) n += folded_cones(oc, oc.boundary[k]);
+      return n;
+    };
+    int best = folded();
+    if (best == 0) continue;
+    std::optional<ClosestPoint<3>> pick;
+    for (const std::int32_t q0 : from)
+      for (const ClosestPoint<3>& c :
+           other_projections(s, oc.points[q0], node_dirs[q0], 4.0 * node_h[q0], opt.max_normals, opt.rays)) {
+        if (by_point.count(std::make_tuple(c.point[0], c.point[1], c.point[2]))) continue;
+        bool ok = true;
+        for (const std::int32_t q : from) ok = ok && proj.admissible(oc.points[q], c.point, node_dirs[q], c.where.patch);
+        if (!ok) continue;
+        oc.points[p] = c.point;
+        const int n = folded();
+        const double out = worst(c.point);
+        if (n < best || (n == best && pick && out > best_out)) best = n, best_out = out, pick = c;
+      }
+    oc.points[p] = old_point;
+    if (!pick) continue;
+    by_point.erase(std::make_tuple(old_point[0], old_point[1], old_point[2]));
+    by_point.emplace(std::make_tuple(pick->point[0], pick->point[1], pick->point[2]), p);
+    oc.points[p] = pick->point;
+    oc.where[p] = pick->where;
+    ++stats.n_unfolded;
+  }
+}
+
 }  // namespace
 
 OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s,
@@ -609,6 +705,8 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
     oc.projection[q] = id;
   }
   res.stats.n_surface_nodes = sources.size();
+  if (opt.unfold_backward && res.problems.empty())
+    unfold_backward(s, proj, node_dirs, node_h, opt, sources, by_point, oc, res.stats);
   oc.snapped.assign(oc.points.size(), 0);
   oc.unsnapped = oc.points;
   if (!res.problems.empty() || !opt.snap_features) return res;

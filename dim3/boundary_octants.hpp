@@ -66,6 +66,7 @@ struct BoundaryOctantStats {
   std::size_t n_next_normal = 0;     ///< projections that took a further local minimum
   std::size_t n_ray = 0;             ///< projections found along a free face's normal
   std::size_t n_blind = 0;           ///< inadmissible closest points kept (blind_closest)
+  std::size_t n_unfolded = 0;        ///< backward projections replaced (unfold_backward)
   std::size_t n_corners_snapped = 0;
   std::size_t n_corners_missed = 0;
   std::size_t n_edge_snapped = 0;
@@ -118,6 +119,16 @@ struct BoundaryOctantOptions {
   /// min_outward must hold for every free face of the node, not just one.
   bool outward_all_faces = false;
   bool rays = true;                  ///< try rays along the free faces' normals
+  /// Unfold backward projections (unfold_backward in boundary_octants.cpp): a surface node
+  /// whose projection runs back against a free face of its face node (cos < 0) and folds cones
+  /// of its boundary octants takes the other candidate (next local minima, rays) that folds
+  /// fewest. Off by default: it halves the raw inverted tetrahedra of the first trees (diagnose3d,
+  /// with snapping: rotor L6 24931 -> 11193, spool L6 11650 -> 7717; case 180 L3 196 -> 114)
+  /// but the untangling leaves about as many behind, so regressions/mayfail-voxel-seed5-case180
+  /// is still refused through every try and spool L6 still fails its tries; at level 4 it
+  /// changes meshes that were valid (anchor 12.73 -> 12.21 deg; elephant then valid only
+  /// without feature snapping; spool 14.30 -> 14.54 deg). docs/measurements.md, session f1.
+  bool unfold_backward = false;
   int n_threads = 1;                 ///< threads for the projections (the result is the same for any)
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes

@@ -699,6 +699,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     bo.min_facing = opt.min_facing;
     bo.outward_all_faces = opt.outward_all_faces;
     bo.rays = opt.projection_rays;
+    bo.unfold_backward = opt.unfold_backward;
     bo.n_threads = opt.n_threads;
     OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
     clock.lap("boundary octants");

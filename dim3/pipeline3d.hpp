@@ -47,6 +47,7 @@ struct Options3d {
   double min_facing = -1.0;
   bool outward_all_faces = false;
   bool projection_rays = true;
+  bool unfold_backward = false;      ///< BoundaryOctantOptions::unfold_backward (off: see there)
   int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
   int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
   int escobar_sweeps = 100;          ///< last-resort untangling sweeps by the Escobar objective (0 = none)

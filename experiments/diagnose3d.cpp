@@ -16,6 +16,9 @@
 // under 10 degrees by where they come from (print_quality_diagnosis).
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
 // retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
+// --unfold turns on BoundaryOctantOptions::unfold_backward (here and with --pipeline). The
+// counts also give the face nodes with free faces on both sides of an axis (no single
+// projection leaves through both) and the folded octants with such a node.
 
 #include <cmath>
 #include <cstdio>
@@ -149,6 +152,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--all") bo.outward_all_faces = true;
     if (std::string(argv[i]) == "--norays") bo.rays = false;
+    if (std::string(argv[i]) == "--unfold") bo.unfold_backward = true;
     if (std::string(argv[i]) == "--snap") bo.snap_features = true;
     if (std::string(argv[i]) == "--near" && i + 4 < argc) {
       near_on = true;
@@ -169,6 +173,7 @@ int main(int argc, char** argv) {
   opt.min_facing = bo.min_facing;
   opt.outward_all_faces = bo.outward_all_faces;
   opt.projection_rays = bo.rays;
+  opt.unfold_backward = bo.unfold_backward;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--accept-folds") opt.accept_valid_folds = true;
   for (int i = 1; i + 1 < argc; ++i) {
@@ -239,9 +244,9 @@ int main(int argc, char** argv) {
               path.c_str(), level, so.thickness_cells, tree.n_leaves(), n_in, nb, np, ni);
   const OctantComplexResult ocr = build_octant_complex(tree, in, s, bo);
   const OctantComplex& oc = ocr.complex;
-  std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu, edge-snapped %zu, pushed off lines %zu\n",
+  std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu, unfolded %zu, edge-snapped %zu, pushed off lines %zu\n",
               ocr.stats.n_free_faces, ocr.stats.n_surface_nodes, ocr.stats.n_next_normal, ocr.stats.n_ray,
-              ocr.stats.n_blind, ocr.stats.n_edge_snapped, ocr.stats.n_pushed_off_lines);
+              ocr.stats.n_blind, ocr.stats.n_unfolded, ocr.stats.n_edge_snapped, ocr.stats.n_pushed_off_lines);
   const SurfacePointFn sp = [&](const P3& p) {
     const ClosestPoint<3> cp = s.closest_point(p);
     return std::make_pair(P3(cp.point), cp.where);
@@ -312,6 +317,26 @@ int main(int argc, char** argv) {
       }
       ++shown;
     }
+  }
+  {
+    // Face nodes with free faces on both sides along an axis (a slab one octant thick): no
+    // single projection leaves through both.
+    std::map<std::int32_t, unsigned> dirs;
+    for (const BoundaryOctant& b : oc.boundary)
+      for (std::int32_t q : b.ring) dirs[q] |= 1u << b.face;
+    const auto opposing = [&](std::int32_t q) {
+      const unsigned d = dirs[q];
+      return (d & 3u) == 3u || (d & 12u) == 12u || (d & 48u) == 48u;
+    };
+    std::size_t n_opp = 0, n_bad_opp = 0;
+    for (const auto& [q, d] : dirs) n_opp += opposing(q) ? 1 : 0;
+    for (std::int32_t k : bad_octants) {
+      bool any = false;
+      for (std::int32_t q : oc.boundary[k].ring) any = any || opposing(q);
+      n_bad_opp += any ? 1 : 0;
+    }
+    std::printf("face nodes %zu, with opposing free faces %zu; folded octants with such a node %zu\n", dirs.size(),
+                n_opp, n_bad_opp);
   }
   std::printf("raw inverted tets %zu (interior cells %zu) in %zu boundary octants of %zu\n", n_bad, n_bad_interior,
               bad_octants.size(), oc.boundary.size());

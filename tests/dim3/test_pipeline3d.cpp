@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/validate.hpp"
 #include "dim3/fidelity3d.hpp"
@@ -163,4 +164,53 @@ TEST_CASE("mesh3d gives the same mesh and counts on 1 and 2 threads", "[pipeline
   CHECK(one.stats.n_ray == two.stats.n_ray);
   CHECK(one.stats.n_blind == two.stats.n_blind);
   CHECK(one.n_optimize_moves == two.n_optimize_moves);
+}
+
+// Backward projections (issue 6, BoundaryOctantOptions::unfold_backward, off by default): a
+// face node's closest point that runs back against one of its free faces folds that face's
+// boundary octant. On the first tree of regressions/mayfail-voxel-seed5-case180-refused.off at
+// level 3 (diagnose3d, no feature snapping) the rule moves 49 surface nodes and the raw
+// inverted tetrahedra of the templates go 196 -> 114; it must move some, and leave fewer.
+TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra", "[pipeline3d][boundary_octants]") {
+  const std::string file =
+      std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/mayfail-voxel-seed5-case180-refused.off";
+  SurfaceBoundary s = SurfaceBoundary::from_file(file);
+  s.set_global_level(3);
+  s.set_max_level(5);
+  RefineOptions ro;
+  ro.max_level = 7;
+  const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
+  const Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
+  Flags in = interior_flags(classify(tree, s));
+  apply_buffer(tree, in, s, 0.2);
+  remove_pinches(tree, in);
+  keep_largest_components(tree, in, s.n_components());
+  const SurfacePointFn sp = [&](const P3& p) {
+    const ClosestPoint<3> cp = s.closest_point(p);
+    return std::make_pair(P3(cp.point), cp.where);
+  };
+  const auto raw_inverted = [&](bool unfold, std::size_t& n_unfolded) {
+    BoundaryOctantOptions bo;
+    bo.snap_features = false;
+    bo.unfold_backward = unfold;
+    const OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
+    REQUIRE(oc.problems.empty());
+    n_unfolded = oc.stats.n_unfolded;
+    const TetMesh fe = tetrahedralize(tree, oc.complex, sp);
+    std::size_t n = 0;
+    for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+      const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+      const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
+               &d = fe.mesh.points[v[3].v];
+      n += (b - a).dot((c - a).cross(d - a)) > 0 ? 0 : 1;
+    }
+    return n;
+  };
+  std::size_t moved_off = 0, moved_on = 0;
+  const std::size_t off = raw_inverted(false, moved_off);
+  const std::size_t on = raw_inverted(true, moved_on);
+  INFO("raw inverted tetrahedra without the rule " << off << ", with it " << on << " (" << moved_on << " moved)");
+  CHECK(moved_off == 0);
+  CHECK(moved_on > 0);
+  CHECK(on < off);
 }
