@@ -206,6 +206,9 @@ std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary&
 
 namespace {
 
+/// The component of `v` along the outward normal of cube face f (f = 2 * axis + side).
+double along_face(const P3& v, int f) { return ((f % 2) ? 1.0 : -1.0) * v[f / 2]; }
+
 struct Projector {
   const Orthtree<3>& tree;
   const Flags& in;
@@ -239,17 +242,15 @@ struct Projector {
       bool facing = min_facing <= -1.0 || patch < 0;
       for (int f = 0; f < Cube<3>::n_faces; ++f) {
         if (!((dirs >> f) & 1)) continue;
-        const double sign = (f % 2) ? 1.0 : -1.0;
-        if (sign * d[f / 2] / len < min_outward) return false;
-        if (sign * np[f / 2] >= min_facing) facing = true;
+        if (along_face(d, f) / len < min_outward) return false;
+        if (along_face(np, f) >= min_facing) facing = true;
       }
       return facing;
     }
     for (int f = 0; f < Cube<3>::n_faces; ++f) {
       if (!((dirs >> f) & 1)) continue;
-      const double sign = (f % 2) ? 1.0 : -1.0;
-      if (sign * d[f / 2] / len < min_outward) continue;
-      if (patch >= 0 && sign * np[f / 2] < min_facing) continue;
+      if (along_face(d, f) / len < min_outward) continue;
+      if (patch >= 0 && along_face(np, f) < min_facing) continue;
       return true;
     }
     return false;
@@ -309,16 +310,23 @@ std::vector<P3> ray_directions(std::uint8_t dirs) {
   return rays;
 }
 
+/// The surface point where the ray from q along `dir` first meets the surface within `reach`
+/// (its closest point, with the distance from q), if it does.
+bool ray_surface_point(const SurfaceBoundary& s, const P3& q, const P3& dir, double reach, ClosestPoint<3>& out) {
+  P3 hit;
+  if (!first_hit(s, q, q + reach * dir, hit)) return false;
+  out = s.closest_point(hit);
+  out.distance = (out.point - q).norm();
+  return true;
+}
+
 /// The first admissible surface point along the rays from q in ray_directions(dirs).
 bool ray_projection(const SurfaceBoundary& s, const Projector& proj, const P3& q, std::uint8_t dirs, double reach,
                     ClosestPoint<3>& out) {
   for (const P3& dir : ray_directions(dirs)) {
-    P3 hit;
-    if (!first_hit(s, q, q + reach * dir, hit)) continue;
-    const ClosestPoint<3> cp = s.closest_point(hit);
-    if (!proj.admissible(q, cp.point, dirs, cp.where.patch)) continue;
+    ClosestPoint<3> cp;
+    if (!ray_surface_point(s, q, dir, reach, cp) || !proj.admissible(q, cp.point, dirs, cp.where.patch)) continue;
     out = cp;
-    out.distance = (cp.point - q).norm();
     return true;
   }
   return false;
@@ -333,7 +341,7 @@ double worst_outward(const P3& q, const P3& p, std::uint8_t dirs) {
   double worst = 1.0;
   if (!(len > 0)) return worst;
   for (int f = 0; f < Cube<3>::n_faces; ++f)
-    if ((dirs >> f) & 1) worst = std::min(worst, ((f % 2) ? 1.0 : -1.0) * d[f / 2] / len);
+    if ((dirs >> f) & 1) worst = std::min(worst, along_face(d, f) / len);
   return worst;
 }
 
@@ -346,11 +354,8 @@ std::vector<ClosestPoint<3>> other_projections(const SurfaceBoundary& s, const P
   if (!out.empty()) out.erase(out.begin());
   if (rays)
     for (const P3& dir : ray_directions(dirs)) {
-      P3 hit;
-      if (!first_hit(s, q, q + reach * dir, hit)) continue;
-      ClosestPoint<3> c = s.closest_point(hit);
-      c.distance = (c.point - q).norm();
-      out.push_back(c);
+      ClosestPoint<3> c;
+      if (ray_surface_point(s, q, dir, reach, c)) out.push_back(c);
     }
   return out;
 }
