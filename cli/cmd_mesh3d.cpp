@@ -45,7 +45,8 @@ const char* help_text =
     "  --buffer X          drop interior octants nearer the surface than X times their size\n"
     "                      (0..0.5, default 0.2)\n"
     "  --smooth N          smoothing iterations (0..50, default 4)\n"
-    "  --no-features       do not snap to feature edges and corners\n"
+    "  --no-features       do not snap to feature edges and corners (also skipped on a\n"
+    "                      faceted surface, where most feature lines end in smooth surface)\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -171,7 +172,8 @@ int run(const std::vector<std::string>& argv) {
                     {"components", surface.n_components()},
                     {"volume", surface.volume()},
                     {"feature_edges", surface.features().n_feature_edges()},
-                    {"corners", surface.features().n_corners()}};
+                    {"corners", surface.features().n_corners()},
+                    {"feature_free_end_share", surface.features().free_end_share()}};
   std::size_t n_interior = 0;
   for (auto f : r.interior) n_interior += f ? 1 : 0;
   rep["counts"] = {{"nodes", mesh.points.size()},

@@ -103,6 +103,15 @@ Features::Features(const Surface& s, FeatureOptions options) {
     if (line_of_[k] < 0) walk(s.edge(edges_[k])[0], edges_[k]);
 }
 
+double Features::free_end_share() const {
+  int ends = 0, free = 0;
+  for (int d : degree_) {
+    ends += d == 1 || d >= 3;
+    free += d == 1;
+  }
+  return ends == 0 ? 0.0 : static_cast<double>(free) / ends;
+}
+
 Features::LinePoint Features::closest_on_line(std::int32_t line, const P3& p) const {
   const FeatureLine& l = lines_[line];
   LinePoint best;

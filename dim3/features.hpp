@@ -55,6 +55,11 @@ class Features {
   const std::vector<FeatureLine>& lines() const { return lines_; }
   /// Line holding feature edge k (an index into feature_edges()).
   std::int32_t line_of(std::int32_t k) const { return line_of_[k]; }
+  /// Share of the vertices where feature lines end (feature degree 1, or 3 and more) that are
+  /// free ends (degree 1: a line stops in the middle of smooth surface); 0 when there are none.
+  /// 0.69 on elephant.off's coarsely faceted skin, whose "features" are facet creases that
+  /// start and stop anywhere; 0-0.08 on the machined parts, whose lines end where others meet.
+  double free_end_share() const;
 
   struct LinePoint {
     P3 point = P3::Zero();

@@ -383,6 +383,15 @@ Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, Effort& effor
   // projection meshes validly.
   Options3d plain = opt;
   plain.snap_features = false;
+  const double free_ends = s.features().free_end_share();
+  if (free_ends > opt.faceted_free_ends) {
+    if (progress)
+      progress("without feature snapping: " + std::to_string(static_cast<int>(std::lround(100.0 * free_ends))) +
+               "% of the feature lines' ends are free (a faceted surface)");
+    Result3d r = once(plain);
+    r.features_dropped = true;
+    return r;
+  }
   return with_fallback(once, opt, plain, "without feature snapping", &Result3d::features_dropped, progress);
 }
 

@@ -27,6 +27,11 @@ struct Options3d {
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
   bool snap_features = true;
+  /// Snap to features only when at most this share of the feature lines' ends are free ends
+  /// (Features::free_end_share): above it the "features" are facet creases of a faceted skin,
+  /// and snapping pins nodes at their ends into flat slivers (elephant.off: 1.6 deg). 1 keeps
+  /// snapping always. Result3d::features_dropped reports it.
+  double faceted_free_ends = 0.5;
   /// When the run with the buffer rule fails, run once more without it (Result3d::buffer_dropped).
   bool retry_without_buffer = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining

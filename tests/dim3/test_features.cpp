@@ -57,6 +57,7 @@ TEST_CASE("a cube has 12 feature edges, 8 corners and 12 lines", "[features]") {
   CHECK(f.n_feature_edges() == 12);
   CHECK(f.n_corners() == 8);
   CHECK(f.lines().size() == 12);
+  CHECK(f.free_end_share() == 0.0);  // every line ends at a corner where 3 meet
   for (std::int32_t v = 0; v < 8; ++v) CHECK(f.feature_degree(v) == 3);
   check_lines(cube, f);
   // Face diagonals are flat, cube edges are right angles.
@@ -92,5 +93,13 @@ TEST_CASE("features of the data surfaces", "[features]") {
     const Features f(s);
     CHECK(f.n_feature_edges() > 0);
     check_lines(s, f);
+    // Machined parts: lines end where others meet, a few at a tangent-continuous blend (fandisk 0.08).
+    CHECK(f.free_end_share() < 0.1);
   }
+  // elephant.off's skin is faceted: most of its 30-degree creases start and stop in smooth
+  // surface, which is how mesh3d tells it from a machined part (Options3d::faceted_free_ends).
+  const Surface elephant = data("elephant.off");
+  const Features fe(elephant);
+  check_lines(elephant, fe);
+  CHECK(fe.free_end_share() > 0.5);
 }

@@ -58,16 +58,17 @@ TEST_CASE("mesh3d refuses an open surface with exit 1 and writes nothing", "[pip
   std::filesystem::remove(out.string() + ".err");
 }
 
-// The work bound (Options3d::effort): the coarse perturbed sphere of the regressions needs 3
-// repairs with feature snapping, then meshes without it (3088 + 5461 + 8856 + 11775 + 3088 =
-// 32268 octants built on, measured). A bound of twice the first tree (6176) stops it at the
-// first repair's tree, where no valid mesh is at hand: LimitError, naming the bound.
+// The work bound (Options3d::effort): the coarse perturbed sphere of the regressions, with
+// feature snapping forced, needs 3 repairs, then meshes without it (3088 + 5461 + 8856 + 11775
+// + 3088 = 32268 octants built on, measured). A bound of twice the first tree (6176) stops it
+// at the first repair's tree, where no valid mesh is at hand: LimitError, naming the bound.
 TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeline3d]") {
   const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/sphere-coarse-inverted-element.off";
   Options3d opt;
   opt.level = 3;
   opt.n_threads = 1;
   opt.min_effort_octants = 0;
+  opt.faceted_free_ends = 1.0;  // snap although its creases are facets (see the next test)
   if (!test::sanitized()) {  // the whole run: 5 CPU s in Release, too long under ASan
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
     const Result3d r = mesh3d(s, opt);
@@ -86,6 +87,23 @@ TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeli
   }
   INFO(what);
   CHECK(what.find("over its work bound of 6176") != std::string::npos);
+}
+
+// Options3d::faceted_free_ends: the same sphere's 30-degree creases are facets, most of them
+// ending in smooth surface, so mesh3d meshes it without feature snapping at once: one tree, no
+// repair, where snapping took 3 repairs and a fallback (above).
+TEST_CASE("mesh3d does not snap to the creases of a faceted surface", "[pipeline3d]") {
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/sphere-coarse-inverted-element.off";
+  SurfaceBoundary s = SurfaceBoundary::from_file(file);
+  INFO("free end share " << s.features().free_end_share());
+  REQUIRE(s.features().free_end_share() > Options3d{}.faceted_free_ends);
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  const Result3d r = mesh3d(s, opt);
+  CHECK(r.features_dropped);
+  CHECK(r.n_octants_built == r.n_leaves_subdivided);
+  CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
 }
 
 // tet_optimize: a cube split into 12 cones from a centre node; the centre pushed out of the cube

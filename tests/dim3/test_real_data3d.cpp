@@ -73,6 +73,7 @@ struct DataRun {
   bool buffer_dropped = false;
   bool facing_projection = false;
   bool thickness_refined = false;
+  bool features_dropped = false;
   double min_dihedral_deg = 0.0;
   double volume_rel_error = 1.0;
 };
@@ -92,7 +93,8 @@ DataRun mesh_and_validate(const std::string& name, const Options3d& opt) {
   const Fidelity3d f = measure_fidelity(m, s, 1);
   CHECK(f.max_node_distance <= vo.boundary_tolerance);
   CHECK(f.volume_rel_error < 0.25);
-  return {r.buffer_dropped, r.facing_projection, r.thickness_refined, q.min_angle_deg, f.volume_rel_error};
+  return {r.buffer_dropped, r.facing_projection, r.thickness_refined, r.features_dropped, q.min_angle_deg,
+          f.volume_rel_error};
 }
 
 DataRun mesh_and_validate(const std::string& name, int level, int max_repairs = 2, bool retry_facing = true,
@@ -215,9 +217,12 @@ TEST_CASE("mesh3d data: elephant level 4 (valid after refining around its island
   // repairs, one of them the refinement of the octants on the surface for a lost handle (Euler
   // characteristic -1, expected -2). Here that run directly (buffer 0), which is what mesh3d
   // reaches: measured 1172552 tets, min dihedral 1.10 deg, volume error 0.32%; issue 6 (CLI):
-  // 1.63 deg, its worst tetrahedra now at fixed feature corners.
+  // 1.63 deg, its worst tetrahedra at feature corners fixed where its facet creases end in
+  // smooth skin. Session 15: those creases are not snapped to (Options3d::faceted_free_ends;
+  // 69% of the line ends are free): 1172412 tets, 13.80 deg, 0.35%, 47.8 s CPU instead of 77.6.
   const DataRun d = mesh_and_validate("elephant", 4, 6, false, 0.0);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 1.5);
+  CHECK(d.features_dropped);
+  CHECK(d.min_dihedral_deg >= 12.0);
   CHECK(d.volume_rel_error < 0.01);
 }
