@@ -124,8 +124,8 @@ struct BoundaryOctantOptions {
   /// of its boundary octants takes the other candidate (next local minima, rays) that folds
   /// fewest. Off by default: it halves the raw inverted tetrahedra of the first trees (diagnose3d,
   /// with snapping: rotor L6 24931 -> 11193, spool L6 11650 -> 7717; case 180 L3 196 -> 114)
-  /// but the untangling leaves about as many behind, so regressions/mayfail-voxel-seed5-case180
-  /// is still refused through every try and spool L6 still fails its tries; at level 4 it
+  /// but the untangling leaves about as many behind, so regressions/voxel-seed5-case180 is still
+  /// refused at level 3 through every try and spool L6 still fails its tries; at level 4 it
   /// changes meshes that were valid (anchor 12.73 -> 12.21 deg; elephant then valid only
   /// without feature snapping; spool 14.30 -> 14.54 deg). docs/measurements.md, session f1.
   bool unfold_backward = false;

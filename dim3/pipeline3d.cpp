@@ -461,13 +461,51 @@ double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {
 
 }  // namespace
 
+namespace {
+
+/// mesh3d_facing, and when every try is refused although they built on fewer octants than
+/// opt.min_effort_octants (a coarse level: the features are a couple of octants across), once
+/// more one level finer within that many octants (Result3d::level_raised). Measured: the 4x4x4
+/// voxel union of tests/dim3/regressions (seed 5, case 180) is refused at level 3 through every
+/// try and valid at levels 4 and 5. A costly refusal (spool L6: millions of octants) stands.
+Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
+  try {
+    return mesh3d_facing(s, opt, effort, progress);
+  } catch (const GeometryError& e) {
+    if (opt.raise_levels <= 0 || effort.used >= opt.min_effort_octants) throw;
+    if (progress) progress("refused at level " + std::to_string(opt.level) + " (" + e.what() + "): once more at level " +
+                           std::to_string(opt.level + 1));
+    Options3d finer = opt;
+    ++finer.level;
+    --finer.raise_levels;
+    finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);  // refused early, not after a huge tree
+    Effort raised;
+    raised.limit = opt.min_effort_octants;
+    Result3d r;
+    try {
+      r = mesh3d_raised(s, finer, raised, progress);
+    } catch (const LimitError& limit) {
+      throw GeometryError(std::string(e.what()) + "; at level " + std::to_string(finer.level) + ": " + limit.what());
+    } catch (const GeometryError& finer_error) {
+      throw GeometryError(std::string(e.what()) + "; at level " + std::to_string(finer.level) + ": " + finer_error.what());
+    }
+    effort.used += raised.used;
+    r.level_raised += 1;
+    return r;
+  }
+}
+
+}  // namespace
+
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   Effort effort;
-  Result3d r = mesh3d_facing(s, opt, effort, progress);
+  Result3d r = mesh3d_raised(s, opt, effort, progress);
   r.n_octants_built = effort.used;
-  if (!(opt.thin_retry_cells > 0) || opt.thickness_cells > 0) return r;
+  Options3d ran = opt;  // the thickness retry below is at the level the mesh was made at
+  ran.level += r.level_raised;
+  if (!(ran.thin_retry_cells > 0) || ran.thickness_cells > 0) return r;
   const double error = volume_error(r.fe.mesh, s);
-  if (!(error > opt.thin_retry_error)) return r;
+  if (!(error > ran.thin_retry_error)) return r;
   // Parts thinner than the octants (rotor's blades, spool's flanges at level 4) have no
   // interior octant and are lost; the mesh is valid but misses them. Once more with the
   // thickness level (thin_retry_cells octants across every part, up to level +
@@ -475,8 +513,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   // project through them (diagnose3d: spool L4 raw inverted tets 4167 with it, 1243 without).
   // Only here, so that the meshes that keep their volume stay bit for bit the same; the retry
   // stands only when it is valid and loses less.
-  Options3d thin = opt;
-  thin.thickness_cells = opt.thin_retry_cells;
+  Options3d thin = ran;
+  thin.thickness_cells = ran.thin_retry_cells;
   thin.buffer = 0.0;
   // No refinement of every octant on the surface for lost topology: on the thickness-refined
   // tree it multiplies the octants (rotor L4: 37927 -> 116145 -> 311522 over the repairs, 2.5
@@ -485,9 +523,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   // A bounded retry: a few repairs per try, trees of at most 8x the first tree's octants (1M
   // at least), and its own work bound of thin_retry_effort. Unbounded, rotor L5's retry ran for
   // more than 17 CPU minutes without a mesh; past the bounds the first mesh stands.
-  thin.max_repairs = std::min(opt.max_repairs, 4);
-  thin.max_cells = std::min(opt.max_cells, std::max<std::size_t>(8 * r.tree.n_leaves(), std::size_t{1} << 20));
-  thin.effort = std::min(opt.effort, opt.thin_retry_effort);
+  thin.max_repairs = std::min(ran.max_repairs, 4);
+  thin.max_cells = std::min(ran.max_cells, std::max<std::size_t>(8 * r.tree.n_leaves(), std::size_t{1} << 20));
+  thin.effort = std::min(ran.effort, ran.thin_retry_effort);
   thin.min_effort_octants = 0;
   if (progress)
     progress("volume error " + std::to_string(100 * error) + "%: once more with " + std::to_string(thin.thickness_cells) +
@@ -503,6 +541,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
                ", volume error " + std::to_string(100 * t_error) + "%");
     if (v.valid && t_error < error) {
       t.thickness_refined = true;
+      t.level_raised = r.level_raised;
       std::vector<StageTime3> times = std::move(r.times);
       times.insert(times.end(), t.times.begin(), t.times.end());
       t.times = std::move(times);
@@ -513,7 +552,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   } catch (const LimitError& e) {
     if (progress) progress(std::string("thin parts: over the retry's bounds (") + e.what() + "); keeping the first mesh");
   }
-  s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+  s.set_thickness_level(ran.thickness_cells, ran.level + ran.thickness_extra_levels);
   r.n_octants_built += thin_effort.used;
   return r;
 }

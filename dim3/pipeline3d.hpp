@@ -108,6 +108,10 @@ struct Options3d {
   /// per octant on every try, so `effort` is about the run's cost in first builds.
   double effort = 60.0;
   std::size_t min_effort_octants = 2000000;
+  /// When every try is refused after building on fewer than min_effort_octants octants (a
+  /// coarse level for the shape), mesh3d tries up to this many levels finer, each within
+  /// min_effort_octants octants (Result3d::level_raised). 0: refuse instead.
+  int raise_levels = 1;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;
@@ -133,6 +137,7 @@ struct Result3d {
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
+  int level_raised = 0;              ///< refused at Options3d::level; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
@@ -147,7 +152,8 @@ using Progress3 = std::function<void(const std::string&)>;
 /// LimitError when the tree would exceed max_cells. `s` gets the options' levels. When it fails
 /// with feature snapping it runs once more without (Result3d::features_dropped); when both fail
 /// with the buffer rule, the two once more without it (Result3d::buffer_dropped); when all
-/// fail, those without the buffer once more with facing projections (Options3d::retry_facing).
+/// fail, those without the buffer once more with facing projections (Options3d::retry_facing);
+/// when those are refused cheaply, all of it one level finer (Options3d::raise_levels).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 /// The options of mesh3d's last try when every other fails (Options3d::retry_facing): `opt`

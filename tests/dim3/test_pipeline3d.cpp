@@ -186,12 +186,12 @@ TEST_CASE("mesh3d gives the same mesh and counts on 1 and 2 threads", "[pipeline
 
 // Backward projections (issue 6, BoundaryOctantOptions::unfold_backward, off by default): a
 // face node's closest point that runs back against one of its free faces folds that face's
-// boundary octant. On the first tree of regressions/mayfail-voxel-seed5-case180-refused.off at
+// boundary octant. On the first tree of regressions/voxel-seed5-case180-level-raised.off at
 // level 3 (diagnose3d, no feature snapping) the rule moves 49 surface nodes and the raw
 // inverted tetrahedra of the templates go 196 -> 114; it must move some, and leave fewer.
 TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra", "[pipeline3d][boundary_octants]") {
   const std::string file =
-      std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/mayfail-voxel-seed5-case180-refused.off";
+      std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-seed5-case180-level-raised.off";
   SurfaceBoundary s = SurfaceBoundary::from_file(file);
   s.set_global_level(3);
   s.set_max_level(5);

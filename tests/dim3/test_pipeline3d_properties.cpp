@@ -222,12 +222,13 @@ TEST_CASE("3D pipeline output is valid on tori", "[property][pipeline3d]") {
 // the last try may take one repair that makes things worse (session h1): regressions/voxel-
 // island-trial.off. The seed-4 survey's 200 cases then all pass; seed 5: 199 of 200, case
 // 180 (a 4x4x4 union, level 3) refused, inverted tets at several sheared boundary octants
-// through every try (regressions/mayfail-voxel-seed5-case180-refused.off).
+// through every try (regressions/voxel-seed5-case180-level-raised.off).
 // Session 12: seed 6, 200 of 200 valid, so 599 of 600 over seeds 4-6. Asserted hard: a change
-// that breaks a case fails the suite; case 180 stays a known failure in its mayfail regression
-// (its leftover inverted tets sit in boundary octants with a corner whose projection runs
-// against the octant's face, cos -0.36 to -0.8, chosen for another free face of its node; in
-// the facing try, in octants with projections 2.5-6.4 face sizes long).
+// that breaks a case fails the suite. Case 180's leftover inverted tets at level 3 sit in
+// boundary octants with a corner whose projection runs against the octant's face, cos -0.36
+// to -0.8, chosen for another free face of its node (in the facing try, in octants with
+// projections 2.5-6.4 face sizes long); since session 15 a refusal that cheap is meshed one
+// level finer (Options3d::raise_levels), where it is valid.
 TEST_CASE("3D pipeline output is valid on voxel unions", "[property][pipeline3d]") {
   validity_property("voxel unions", 4, test::gen_voxel_spec(), 3);
 }
@@ -376,8 +377,9 @@ TEST_CASE("shrunk 3D property counterexamples mesh validly", "[pipeline3d][regre
   // them the sanitizer suite's dim3 test took 609 s instead of about 200.
   const std::set<std::string> slow = {"torus-seed12-case195-euler.off", "voxel-hanging-node-concave-edge.off",
                                       "voxel-island-trial.off"};
+  const std::string raised = "voxel-seed5-case180-level-raised.off";  // its own test below
   for (const fs::path& f : regression_files(false))
-    if (!(test::sanitized() && slow.count(f.filename().string()))) check_regression(f);
+    if (f.filename() != raised && !(test::sanitized() && slow.count(f.filename().string()))) check_regression(f);
 }
 
 TEST_CASE("a fin of a boundary octant is cancelled rather than refined around", "[pipeline3d][regression]") {
@@ -391,6 +393,21 @@ TEST_CASE("a fin of a boundary octant is cancelled rather than refined around", 
   CHECK(out.v.valid);
   CHECK(out.r.fe.n_fins_cancelled > 0);
   CHECK(out.r.n_repairs == 0);
+}
+
+TEST_CASE("a cheap refusal at a coarse level is meshed one level finer", "[pipeline3d][regression]") {
+  // The 4x4x4 voxel union of seed 5, case 180 at level 3: every try is refused (inverted
+  // tetrahedra at its concave edges, two octants apart), after about 0.3M octants built;
+  // Options3d::raise_levels meshes it at level 4 (measured: 68248 tets, 4.77 deg, 5.7% volume
+  // lost at its one-voxel parts, 15.7 s CPU in Release). Without the raise it is refused.
+  if (test::sanitized()) return;  // too slow under ASan; the Release suite runs it
+  const fs::path file = fs::path(FEBEMESH_SOURCE_DIR) / "tests" / "dim3" / "regressions" / "voxel-seed5-case180-level-raised.off";
+  REQUIRE(file_level(file) == 3);
+  std::ifstream in(file);
+  const Outcome3 out = run_surface(Surface(read_off(in, file.string())), 3);
+  INFO(out.v.summary());
+  CHECK(out.v.valid);
+  CHECK(out.r.level_raised == 1);
 }
 
 TEST_CASE("shrunk 3D property counterexamples not fixed yet", "[pipeline3d][regression][!mayfail]") {
