@@ -187,6 +187,7 @@ int run(const std::vector<std::string>& argv) {
                    {"boundary_octants", r.stats.n_free_faces},
                    {"buffer_dropped", r.n_buffer_dropped},
                    {"pinches_dropped", r.n_pinches_dropped},
+                   {"opposing_dropped", r.n_opposing_dropped},
                    {"islands_dropped", r.n_islands_dropped},
                    {"surface_nodes", r.stats.n_surface_nodes},
                    {"shared_projections", r.stats.n_shared_projections},

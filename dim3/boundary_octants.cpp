@@ -145,6 +145,60 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
   return removed;
 }
 
+std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function<double(const P3&)>& depth_at) {
+  std::size_t removed = 0;
+  std::map<std::size_t, double> depth;  // leaf -> distance of its centre to the surface (memo)
+  const auto depth_of = [&](std::size_t leaf) {
+    auto it = depth.find(leaf);
+    if (it == depth.end()) {
+      const Box<3> b = geometry(t, t.leaf(leaf));
+      it = depth.emplace(leaf, depth_at(P3(0.5 * (b.lo + b.hi)))).first;
+    }
+    return it->second;
+  };
+  for (int pass = 0; pass < 8; ++pass) {
+    std::map<std::uint64_t, LP> points;  // ordered by key: deterministic
+    for (const FreeFacet<3>& f : free_facets(t, in))
+      for (const LP& p : f.corners()) points.emplace(point_key<3>(p), p);
+    std::vector<std::size_t> drop;
+    for (const auto& [key, p] : points) {
+      const auto around = octants_around(t, p);
+      unsigned kept = 0;
+      for (int o = 0; o < 8; ++o)
+        if (around[o] != no_leaf && in[around[o]]) kept |= 1u << o;
+      for (int d = 0; d < 3; ++d) {
+        // Kept octants with a free face at p facing -d (upper side along d, the lower one
+        // unkept) and facing +d (the other way round).
+        unsigned down = 0, up = 0;
+        for (int o = 0; o < 8; ++o) {
+          if (!((kept >> o) & 1u) || ((kept >> (o ^ (1 << d))) & 1u)) continue;
+          if ((o >> d) & 1) down |= 1u << o;
+          else up |= 1u << o;
+        }
+        if (down == 0 || up == 0) continue;
+        // Drop the one of them nearest the surface (ties: the lower leaf).
+        std::size_t best = no_leaf;
+        double best_depth = 0.0;
+        for (int o = 0; o < 8; ++o) {
+          if (!(((down | up) >> o) & 1u)) continue;
+          const double dep = depth_of(around[o]);
+          if (best == no_leaf || dep < best_depth || (dep == best_depth && around[o] < best)) best = around[o], best_depth = dep;
+        }
+        drop.push_back(best);
+        break;
+      }
+    }
+    std::sort(drop.begin(), drop.end());
+    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
+    std::size_t n = 0;
+    for (std::size_t i : drop)
+      if (in[i]) in[i] = 0, ++n;
+    removed += n;
+    if (n == 0) break;
+  }
+  return removed;
+}
+
 std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep) {
   std::vector<std::int32_t> comp(t.n_leaves(), -1);
   std::vector<std::size_t> size;

@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,15 @@ struct OctantComplexResult {
 /// boundary: around each free-face corner the kept and the unkept ones among the eight octants
 /// must each be face-connected. Returns how many octants were dropped.
 std::size_t remove_pinches(const Orthtree<3>& t, Flags& in);
+
+/// Drop interior octants so that no node of the interior region's boundary has free faces on
+/// both sides along an axis (a staircase twisted around the node: kept and unkept octants each
+/// face-connected, so not a pinch). No single projection of such a node leaves through both
+/// faces, and one of their boundary octants folds (diagnose3d: 70 such nodes on spool's first
+/// tree at level 6, none at level 5). Of the octants with those faces, the one whose centre is
+/// nearest the surface (`depth_at` its centre: the distance to the surface) goes; up to 8
+/// passes. Returns how many octants were dropped.
+std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function<double(const P3&)>& depth_at);
 
 /// Keep the `n_keep` largest face-connected components of the interior octants, drop the others
 /// (islands left in parts thinner than the octants would be extra solids). Returns how many

@@ -656,6 +656,14 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer);
     r.n_peeled = peel(tree, in, peel_points);
     r.n_pinches_dropped = remove_pinches(tree, in);
+    r.n_opposing_dropped = 0;
+    const auto depth_at = [&s](const P3& p) { return s.closest_point(p).distance; };
+    for (int round = 0; opt.drop_opposing && round < 4; ++round) {
+      const std::size_t k = remove_opposing(tree, in, depth_at);
+      if (k == 0) break;
+      r.n_opposing_dropped += k;
+      r.n_pinches_dropped += remove_pinches(tree, in);
+    }
     const Flags before_islands = in;
     r.n_islands_dropped = keep_largest_components(tree, in, s.n_components());
     if (island_trial) {
@@ -721,6 +729,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     if (r.n_islands_dropped > 0) r.n_pinches_dropped += remove_pinches(tree, in);
     say("interior octants: " + std::to_string(r.n_buffer_dropped) + " dropped by the buffer rule, " +
         std::to_string(r.n_peeled) + " peeled, " + std::to_string(r.n_pinches_dropped) + " for pinches, " +
+        (r.n_opposing_dropped > 0 ? std::to_string(r.n_opposing_dropped) + " for opposing free faces, " : std::string()) +
         std::to_string(r.n_islands_dropped) + " in islands");
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
 

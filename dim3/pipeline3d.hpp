@@ -27,6 +27,15 @@ struct Options3d {
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
   bool snap_features = true;
+  /// Drop interior octants at nodes with free faces on both sides along an axis
+  /// (remove_opposing), after the pinch rule. Off: measured (CLI, L4, one thread, tets / min
+  /// dihedral) elephant 1172412 / 13.80 -> 1187662 / 17.04 deg, anchor 276042 / 12.73 ->
+  /// 275610 / 12.72, rotor 68398 / 16.73 -> 76936 / 16.94, but fandisk 180486 / 13.18 ->
+  /// 271352 / 12.52 in 19.7 s CPU instead of 11.5; sphere966 and spool byte-identical (none
+  /// there). Spool L6 without the buffer rule is still refused (diagnose3d --pipeline: raw
+  /// inverted tets of the first tree 2503 -> 1888, the repairs end with 158-171 problems at the
+  /// same place as without it).
+  bool drop_opposing = false;
   /// Snap to features only when at most this share of the feature lines' ends are free ends
   /// (Features::free_end_share): above it the "features" are facet creases of a faceted skin,
   /// and snapping pins nodes at their ends into flat slivers (elephant.off: 1.6 deg). 1 keeps
@@ -127,6 +136,7 @@ struct Result3d {
   std::size_t n_leaves_subdivided = 0;
   std::size_t n_buffer_dropped = 0;
   std::size_t n_pinches_dropped = 0;
+  std::size_t n_opposing_dropped = 0;  ///< interior octants dropped by remove_opposing
   std::size_t n_islands_dropped = 0;  ///< interior octants outside the largest components
   std::size_t n_untangled = 0;       ///< surface node moves that unfolded inverted tets
   std::size_t n_peeled = 0;          ///< interior octants dropped around blind face nodes

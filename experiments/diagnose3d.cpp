@@ -16,6 +16,9 @@
 // under 10 degrees by where they come from (print_quality_diagnosis).
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
 // retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
+// --opposing drops the interior octants at nodes with opposing free faces (remove_opposing,
+// Options3d::drop_opposing; here and with --pipeline; FEBEMESH_DUMP_OPPOSING=1 with --dump N
+// lists the first N such nodes of the first tree and their free faces).
 // --unfold turns on BoundaryOctantOptions::unfold_backward (here and with --pipeline). The
 // counts also give the face nodes with free faces on both sides of an axis (no single
 // projection leaves through both) and the folded octants with such a node.
@@ -192,6 +195,8 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--smooth") opt.smoothing_iterations = std::atoi(argv[i + 1]);
   }
   for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--opposing") opt.drop_opposing = true;
+  for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--thin-share") {
       // Share of the surface thinner than k octants of the global level (the thin-first rule).
       const double h = s.root_box().extent()[0] / std::ldexp(1.0, level);
@@ -236,7 +241,17 @@ int main(int argc, char** argv) {
   const std::vector<Side> sides = classify(tree, s);
   Flags in = interior_flags(sides);
   const std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
-  const std::size_t np = remove_pinches(tree, in);
+  std::size_t np = remove_pinches(tree, in);
+  std::size_t n_opposing = 0;
+  for (int i = 0; i < argc; ++i)
+    if (std::string(argv[i]) == "--opposing")
+      for (int round = 0; round < 4; ++round) {
+        const std::size_t k = remove_opposing(tree, in, [&s](const P3& q) { return s.closest_point(q).distance; });
+        if (k == 0) break;
+        n_opposing += k;
+        np += remove_pinches(tree, in);
+      }
+  if (n_opposing > 0) std::printf("opposing free faces: %zu octants dropped\n", n_opposing);
   const std::size_t ni = keep_largest_components(tree, in, s.n_components());
   std::size_t n_in = 0;
   for (auto f : in) n_in += f;
@@ -329,7 +344,18 @@ int main(int argc, char** argv) {
       return (d & 3u) == 3u || (d & 12u) == 12u || (d & 48u) == 48u;
     };
     std::size_t n_opp = 0, n_bad_opp = 0;
-    for (const auto& [q, d] : dirs) n_opp += opposing(q) ? 1 : 0;
+    for (const auto& [q, d] : dirs) {
+      if (!opposing(q)) continue;
+      if (n_opp < static_cast<std::size_t>(dump) && std::getenv("FEBEMESH_DUMP_OPPOSING")) {
+        std::printf("  opposing node %d at (%.4f %.4f %.4f) faces %02x:", q, oc.points[q][0], oc.points[q][1], oc.points[q][2], d);
+        for (const BoundaryOctant& b : oc.boundary)
+          for (std::int32_t r : b.ring)
+            if (r == q) std::printf(" [face %d level %d at (%.4f %.4f %.4f)]", b.face, b.cell.level, geometry(tree, b.cell).lo[0],
+                                    geometry(tree, b.cell).lo[1], geometry(tree, b.cell).lo[2]);
+        std::printf("\n");
+      }
+      ++n_opp;
+    }
     for (std::int32_t k : bad_octants) {
       bool any = false;
       for (std::int32_t q : oc.boundary[k].ring) any = any || opposing(q);
