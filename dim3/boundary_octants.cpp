@@ -39,6 +39,22 @@ std::array<std::size_t, 8> octants_around(const Orthtree<3>& t, const LP& p) {
   return out;
 }
 
+/// The corners of the free faces of the kept octants, ordered by key (deterministic).
+std::map<std::uint64_t, LP> free_face_corners(const Orthtree<3>& t, const Flags& in) {
+  std::map<std::uint64_t, LP> points;
+  for (const FreeFacet<3>& f : free_facets(t, in))
+    for (const LP& p : f.corners()) points.emplace(point_key<3>(p), p);
+  return points;
+}
+
+/// Bit o set: octant o of octants_around is kept.
+unsigned kept_mask(const std::array<std::size_t, 8>& around, const Flags& in) {
+  unsigned kept = 0;
+  for (int o = 0; o < 8; ++o)
+    if (around[o] != no_leaf && in[around[o]]) kept |= 1u << o;
+  return kept;
+}
+
 /// Face-connected components of the octants in `mask` within the 2x2x2 block (octants are
 /// face-adjacent when their indices differ in one bit). comp[o] = component or -1.
 int components(unsigned mask, std::array<int, 8>& comp) {
@@ -89,15 +105,11 @@ std::vector<std::int32_t> face_ring(const LatticeNodes<3>& nodes, const Cell<3>&
 std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
   std::size_t removed = 0;
   for (int pass = 0; pass < 64; ++pass) {
-    std::map<std::uint64_t, LP> points;  // ordered by key: deterministic
-    for (const FreeFacet<3>& f : free_facets(t, in))
-      for (const LP& p : f.corners()) points.emplace(point_key<3>(p), p);
+    const std::map<std::uint64_t, LP> points = free_face_corners(t, in);
     std::vector<std::size_t> drop;
     for (const auto& [key, p] : points) {
       const auto around = octants_around(t, p);
-      unsigned kept = 0;
-      for (int o = 0; o < 8; ++o)
-        if (around[o] != no_leaf && in[around[o]]) kept |= 1u << o;
+      const unsigned kept = kept_mask(around, in);
       std::array<int, 8> ck{}, cu{};
       const int nk = components(kept, ck);
       const int nu = components(~kept & 0xffu, cu);
@@ -157,15 +169,11 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
     return it->second;
   };
   for (int pass = 0; pass < 8; ++pass) {
-    std::map<std::uint64_t, LP> points;  // ordered by key: deterministic
-    for (const FreeFacet<3>& f : free_facets(t, in))
-      for (const LP& p : f.corners()) points.emplace(point_key<3>(p), p);
+    const std::map<std::uint64_t, LP> points = free_face_corners(t, in);
     std::vector<std::size_t> drop;
     for (const auto& [key, p] : points) {
       const auto around = octants_around(t, p);
-      unsigned kept = 0;
-      for (int o = 0; o < 8; ++o)
-        if (around[o] != no_leaf && in[around[o]]) kept |= 1u << o;
+      const unsigned kept = kept_mask(around, in);
       for (int d = 0; d < 3; ++d) {
         // Kept octants with a free face at p facing -d (upper side along d, the lower one
         // unkept) and facing +d (the other way round).
@@ -182,7 +190,10 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
         for (int o = 0; o < 8; ++o) {
           if (!(((down | up) >> o) & 1u)) continue;
           const double dep = depth_of(around[o]);
-          if (best == no_leaf || dep < best_depth || (dep == best_depth && around[o] < best)) best = around[o], best_depth = dep;
+          if (best == no_leaf || dep < best_depth || (dep == best_depth && around[o] < best)) {
+            best = around[o];
+            best_depth = dep;
+          }
         }
         drop.push_back(best);
         break;
@@ -191,8 +202,12 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
     std::sort(drop.begin(), drop.end());
     drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
     std::size_t n = 0;
-    for (std::size_t i : drop)
-      if (in[i]) in[i] = 0, ++n;
+    for (std::size_t i : drop) {
+      if (in[i]) {
+        in[i] = 0;
+        ++n;
+      }
+    }
     removed += n;
     if (n == 0) break;
   }

@@ -459,10 +459,6 @@ double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {
   return std::abs(solid_measure<3>(m) - s.volume()) / std::abs(s.volume());
 }
 
-}  // namespace
-
-namespace {
-
 /// mesh3d_facing, and when every try is refused although they built on fewer octants than
 /// opt.min_effort_octants (a coarse level: the features are a couple of octants across), once
 /// more one level finer within that many octants (Result3d::level_raised). Measured: the 4x4x4
@@ -481,13 +477,16 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
     finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);  // refused early, not after a huge tree
     Effort raised;
     raised.limit = opt.min_effort_octants;
+    const auto both = [&](const std::exception& finer_error) {
+      return GeometryError(std::string(e.what()) + "; at level " + std::to_string(finer.level) + ": " + finer_error.what());
+    };
     Result3d r;
     try {
       r = mesh3d_raised(s, finer, raised, progress);
     } catch (const LimitError& limit) {
-      throw GeometryError(std::string(e.what()) + "; at level " + std::to_string(finer.level) + ": " + limit.what());
+      throw both(limit);
     } catch (const GeometryError& finer_error) {
-      throw GeometryError(std::string(e.what()) + "; at level " + std::to_string(finer.level) + ": " + finer_error.what());
+      throw both(finer_error);
     }
     effort.used += raised.used;
     r.level_raised += 1;
