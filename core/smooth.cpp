@@ -65,9 +65,14 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
         if (a == v) visit(b);
         if (b == v) visit(a);
       };
-      if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
-        const int m = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
-        for (int i = 0; i < m; ++i) edge(nodes[i].v, nodes[i + 1 == m ? (m == 1 ? 1 : 0) : i + 1].v);
+      if (t == ElemType::Tri3 || t == ElemType::Quad4) {
+        // Edges (i, i+1): each place of v gives its two polygon neighbours (the uses the edge
+        // loop below gives, in another order, which the lists' sort and marks do not see).
+        const int m = t == ElemType::Tri3 ? 3 : 4;
+        for (int i = 0; i < m; ++i)
+          if (nodes[i].v == v) visit(nodes[i + 1 == m ? 0 : i + 1].v), visit(nodes[i == 0 ? m - 1 : i - 1].v);
+      } else if (t == ElemType::Line2) {
+        edge(nodes[0].v, nodes[1].v);
       } else if (t == ElemType::Tet4) {  // every pair: v's are those of v's places, with each other node
         for (int i = 0; i < 4; ++i)
           if (nodes[i].v == v)
