@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
 #include "core/orthtree.hpp"
 
@@ -105,7 +106,7 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   constexpr int n_corners = Cube<Dim>::n_corners;
 
   std::vector<std::uint64_t> keys;
-  keys.reserve(t.n_leaves() * n_corners);
+  reserve_huge(keys, t.n_leaves() * n_corners);
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!kept(i)) continue;
     for (const std::uint64_t key : corner_keys(t.leaf(i))) keys.push_back(key);
@@ -117,9 +118,10 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   }
 
   LatticeNodes<Dim> nodes;
-  nodes.points.reserve(keys.size());
+  reserve_huge(nodes.points, keys.size());
   for (const std::uint64_t k : keys) nodes.points.push_back(point_from_key<Dim>(k));
 
+  reserve_huge(nodes.leaf_corners, t.n_leaves());
   nodes.leaf_corners.resize(t.n_leaves());
   std::array<std::size_t, n_corners> near{};  // corner k's answer for the previous kept leaf
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
+#include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
@@ -29,9 +30,11 @@ struct Csr {
 /// Node -> the elements that use it, in increasing order (once per use).
 Csr incident_elements(std::size_t n, const Elements& els) {
   Csr g;
+  reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
   for (const VertexId v : els.node) ++g.start[v.v + 1];
   for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
+  reserve_huge(g.item, std::size_t(g.start[n]));
   g.item.resize(g.start[n]);
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
   for (std::size_t e = 0; e < els.size(); ++e) {
@@ -52,6 +55,7 @@ Csr incident_elements(std::size_t n, const Elements& els) {
 /// boundary_facets(els).
 Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr) {
   Csr g;
+  reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
   // Calls visit(w) for every edge (v, w) of v's elements, once per edge use ((v, v): twice).
   auto each_use = [&](std::int32_t v, auto&& visit) {
@@ -98,6 +102,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     });
     g.start[v + 1] = g.start[v] + count;
   }
+  reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
   std::fill(seen.begin(), seen.end(), -1);
   for (std::size_t v = 0; v < n; ++v) {

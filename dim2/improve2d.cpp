@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
+#include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 
 namespace febemesh::dim2 {
@@ -172,9 +173,11 @@ class LiveIncidence {
  public:
   explicit LiveIncidence(const Mesh<2>& m) { rebuild(m); }
   void rebuild(const Mesh<2>& m) {
+    reserve_huge(first_, m.points.size() + 1);
     first_.assign(m.points.size() + 1, 0);
     for (const VertexId v : m.solid.node) ++first_[static_cast<std::size_t>(v.v) + 1];
     for (std::size_t v = 0; v + 1 < first_.size(); ++v) first_[v + 1] += first_[v] + spare;
+    reserve_huge(elem_, static_cast<std::size_t>(first_.back()));
     elem_.assign(static_cast<std::size_t>(first_.back()), -1);
     for (std::size_t e = 0; e < m.solid.size(); ++e)
       for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k) add(m.solid.node[k].v, static_cast<std::int32_t>(e));
@@ -263,7 +266,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // (element_min_angle) are computed, not kept, when a comparison needs them (rarely: a cache
   // was 8 bytes an element at this stage's memory); every decision below is the one the
   // degrees make (exceeds).
-  std::vector<double> cot(m.solid.size());
+  std::vector<double> cot;
+  reserve_huge(cot, m.solid.size());
+  cot.resize(m.solid.size());
   for (std::size_t e = 0; e < m.solid.size(); ++e) cot[e] = element_top_cot(m, e);
   auto exact = [&](std::size_t e) { return element_min_angle(m, e); };
   // The exact degrees of elements as they stand (not at a trial position), remembered in a
