@@ -83,6 +83,10 @@ template <int Dim> Cell<Dim> cell_from_key(std::uint64_t key, int level);
 /// Morton key of a lattice point; coordinates may equal root_length (upper root faces).
 template <int Dim> std::uint64_t point_key(const LatticePoint<Dim>& p);
 template <int Dim> LatticePoint<Dim> point_from_key(std::uint64_t key);
+/// point_key(corner(c, k)) for every corner k, from the anchor's key by dilated addition: the
+/// side added to the bits of axis d carries through the other axes' bits once those are set
+/// (no interleaving per corner).
+template <int Dim> std::array<std::uint64_t, Cube<Dim>::n_corners> corner_keys(const Cell<Dim>& c);
 /// Is lattice point p a corner of c, and does it lie in the closed lattice box of c.
 template <int Dim> bool is_corner(const Cell<Dim>& c, const LatticePoint<Dim>& p);
 template <int Dim> bool touches(const Cell<Dim>& c, const LatticePoint<Dim>& p);
@@ -199,6 +203,24 @@ template <int Dim> inline LatticePoint<Dim> corner(const Cell<Dim>& c, int k) {
 
 template <int Dim> inline std::uint64_t point_key(const LatticePoint<Dim>& p) {
   return detail::interleave<Dim>(p);
+}
+
+namespace detail {
+/// The bits of axis 0 in a Morton key (axis d: shifted by d), as spread_bits2/3 leave them.
+template <int Dim> inline constexpr std::uint64_t axis0_bits = Dim == 2 ? 0x5555555555555555ULL : 0x1249249249249249ULL;
+}  // namespace detail
+
+template <int Dim> inline std::array<std::uint64_t, Cube<Dim>::n_corners> corner_keys(const Cell<Dim>& c) {
+  std::array<std::uint64_t, Cube<Dim>::n_corners> out;
+  out[0] = morton_key(c);
+  const int side_bit = Dim * (max_level<Dim> - c.level);  // length(c) in axis 0's bits
+  for (int d = 0; d < Dim; ++d) {
+    const std::uint64_t lane = detail::axis0_bits<Dim> << d;
+    const std::uint64_t step = std::uint64_t(1) << (side_bit + d);
+    for (int k = 0; k < (1 << d); ++k)  // corner k | (1 << d) = corner k moved up along d
+      out[k | (1 << d)] = (((out[k] | ~lane) + step) & lane) | (out[k] & ~lane);
+  }
+  return out;
 }
 
 template <int Dim> inline LatticePoint<Dim> point_from_key(std::uint64_t key) {

@@ -1,6 +1,7 @@
 #include "core/free_facets.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -16,12 +17,31 @@ std::array<LatticePoint<Dim>, Cube<Dim>::n_face_corners> FreeFacet<Dim>::corners
 
 namespace {
 
-/// Appends the free facets of kept leaf i, in facet order.
+/// Morton keys [lo, hi) covered without a gap by kept leaves, leaf i's among them; empty when
+/// not known (lo == hi).
+struct KeptKeys {
+  std::uint64_t lo = 0, hi = 0;
+};
+
+/// Appends the free facets of kept leaf i, in facet order. A facet inside a cell all of whose
+/// keys are in `kept` has only kept leaves across it, and no neighbour search is made for it:
+/// most kept leaves lie inside such runs (flange level 9: free_facets 220 M instructions).
 template <int Dim>
 void leaf_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep, std::size_t i,
-                      std::vector<std::size_t>& nb, std::vector<FreeFacet<Dim>>& out) {
+                      std::vector<std::size_t>& nb, std::vector<FreeFacet<Dim>>& out, KeptKeys kept = {}) {
   const Cell<Dim>& c = t.leaf(i);
+  const std::uint64_t key = kept.lo < kept.hi ? morton_key(c) : 0;
   for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+    if (kept.lo < kept.hi) {
+      // The facet lies at x along its axis; x = odd * 2^z, so it is inside the cell of side
+      // 2^(z+1) that holds leaf i (unless it is on the root's boundary).
+      const std::uint32_t x = c.anchor[face_axis(f)] + (face_side(f) ? length(c) : 0);
+      if (x != 0 && x != root_length<Dim>) {
+        const std::uint64_t volume = std::uint64_t(1) << (Dim * (std::countr_zero(x) + 1));
+        const std::uint64_t first = key & ~(volume - 1);
+        if (kept.lo <= first && first + volume <= kept.hi) continue;
+      }
+    }
     keys.face_neighbours(i, f, nb);
     if (nb.empty()) {
       out.push_back({i, f, c});
@@ -57,8 +77,18 @@ template <int Dim>
 std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep) {
   std::vector<FreeFacet<Dim>> out;
   std::vector<std::size_t> nb;
-  for (std::size_t i = 0; i < t.n_leaves(); ++i)
-    if (keep[i]) leaf_free_facets(t, keys, keep, i, nb, out);
+  KeptKeys run;
+  std::size_t run_end = 0;  // leaves [.., run_end) are in `run`
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
+    if (!keep[i]) continue;
+    if (i >= run_end) {  // a new run of kept leaves without key gaps
+      run.lo = morton_key(t.leaf(i));
+      run.hi = run.lo + volume_units(t.leaf(i));
+      for (run_end = i + 1; run_end < t.n_leaves() && keep[run_end] && morton_key(t.leaf(run_end)) == run.hi; ++run_end)
+        run.hi += volume_units(t.leaf(run_end));
+    }
+    leaf_free_facets(t, keys, keep, i, nb, out, run);
+  }
   return out;
 }
 

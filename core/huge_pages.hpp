@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include <sys/mman.h>
 
@@ -23,6 +24,15 @@ inline void advise_huge_pages(const void* p, std::size_t bytes) {
   (void)p;
   (void)bytes;
 #endif
+}
+
+/// v.reserve(n), with huge pages on fresh storage of 4 MiB or more (below, the one partly used
+/// huge page at each end would be a visible share of it, as for the tree's leaves). Call it
+/// before the elements are written (assign, resize or push_back after it).
+template <class T, class A> void reserve_huge(std::vector<T, A>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  v.reserve(n);
+  if (n * sizeof(T) >= (std::size_t(4) << 20)) advise_huge_pages(v.data(), n * sizeof(T));
 }
 
 }  // namespace febemesh

@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
 #include "core/orthtree.hpp"
 
@@ -105,10 +106,10 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   constexpr int n_corners = Cube<Dim>::n_corners;
 
   std::vector<std::uint64_t> keys;
-  keys.reserve(t.n_leaves() * n_corners);
+  reserve_huge(keys, t.n_leaves() * n_corners);
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!kept(i)) continue;
-    for (int k = 0; k < n_corners; ++k) keys.push_back(point_key<Dim>(corner(t.leaf(i), k)));
+    for (const std::uint64_t key : corner_keys(t.leaf(i))) keys.push_back(key);
   }
   radix_sort(keys);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
@@ -117,20 +118,21 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   }
 
   LatticeNodes<Dim> nodes;
-  nodes.points.reserve(keys.size());
+  reserve_huge(nodes.points, keys.size());
   for (const std::uint64_t k : keys) nodes.points.push_back(point_from_key<Dim>(k));
 
+  reserve_huge(nodes.leaf_corners, t.n_leaves());
   nodes.leaf_corners.resize(t.n_leaves());
   std::array<std::size_t, n_corners> near{};  // corner k's answer for the previous kept leaf
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     auto& row = nodes.leaf_corners[i];
+    if (!kept(i)) {
+      row.fill(-1);
+      continue;
+    }
+    const auto corner_key = corner_keys(t.leaf(i));
     for (int k = 0; k < n_corners; ++k) {
-      if (!kept(i)) {
-        row[k] = -1;
-        continue;
-      }
-      const std::uint64_t key = point_key<Dim>(corner(t.leaf(i), k));
-      near[k] = lower_bound_from(keys, key, near[k]);
+      near[k] = lower_bound_from(keys, corner_key[k], near[k]);
       row[k] = std::int32_t(near[k]);
     }
   }

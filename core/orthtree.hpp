@@ -183,8 +183,12 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep = null
 // ---- classification ---------------------------------------------------------------------------
 
 /// IN / OUT / PARTIAL of every leaf against the boundary (paper "Find interior quadrants").
+/// Top-down: a leaf inside a cell that b.classify finds IN or OUT takes that answer, so b's
+/// classify must be monotone in the box (see classify.cpp).
 template <int Dim>
 std::vector<Side> classify(const Orthtree<Dim>& t, const Boundary<Dim>& b, int n_threads = 1);
+/// Slow twin: b.classify of every leaf's own box.
+template <int Dim> std::vector<Side> classify_ref(const Orthtree<Dim>& t, const Boundary<Dim>& b);
 
 // ---- invariants (fast, and slow reference twins: STYLE.md §7) ---------------------------------
 

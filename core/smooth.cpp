@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
+#include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
@@ -29,9 +30,11 @@ struct Csr {
 /// Node -> the elements that use it, in increasing order (once per use).
 Csr incident_elements(std::size_t n, const Elements& els) {
   Csr g;
+  reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
   for (const VertexId v : els.node) ++g.start[v.v + 1];
   for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
+  reserve_huge(g.item, std::size_t(g.start[n]));
   g.item.resize(g.start[n]);
   std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
   for (std::size_t e = 0; e < els.size(); ++e) {
@@ -52,6 +55,7 @@ Csr incident_elements(std::size_t n, const Elements& els) {
 /// boundary_facets(els).
 Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr) {
   Csr g;
+  reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
   // Calls visit(w) for every edge (v, w) of v's elements, once per edge use ((v, v): twice).
   auto each_use = [&](std::int32_t v, auto&& visit) {
@@ -65,9 +69,14 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
         if (a == v) visit(b);
         if (b == v) visit(a);
       };
-      if (t == ElemType::Line2 || t == ElemType::Tri3 || t == ElemType::Quad4) {  // edges (k, k+1)
-        const int m = t == ElemType::Line2 ? 1 : t == ElemType::Tri3 ? 3 : 4;
-        for (int i = 0; i < m; ++i) edge(nodes[i].v, nodes[i + 1 == m ? (m == 1 ? 1 : 0) : i + 1].v);
+      if (t == ElemType::Tri3 || t == ElemType::Quad4) {
+        // Edges (i, i+1): each place of v gives its two polygon neighbours (the uses the edge
+        // loop below gives, in another order, which the lists' sort and marks do not see).
+        const int m = t == ElemType::Tri3 ? 3 : 4;
+        for (int i = 0; i < m; ++i)
+          if (nodes[i].v == v) visit(nodes[i + 1 == m ? 0 : i + 1].v), visit(nodes[i == 0 ? m - 1 : i - 1].v);
+      } else if (t == ElemType::Line2) {
+        edge(nodes[0].v, nodes[1].v);
       } else if (t == ElemType::Tet4) {  // every pair: v's are those of v's places, with each other node
         for (int i = 0; i < 4; ++i)
           if (nodes[i].v == v)
@@ -93,6 +102,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     });
     g.start[v + 1] = g.start[v] + count;
   }
+  reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
   std::fill(seen.begin(), seen.end(), -1);
   for (std::size_t v = 0; v < n; ++v) {

@@ -2,6 +2,7 @@
 // between cells (the real point is mapped to the lattice once).
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -252,7 +253,41 @@ template <int Dim> void LeafKeys<Dim>::face_neighbours(std::size_t i, int f, std
 
 template <int Dim> std::vector<std::size_t> leaves_in_box(const Orthtree<Dim>& t, const Box<Dim>& b) {
   std::vector<std::size_t> out;
-  box_leaves(t, Cell<Dim>{}, 0, t.n_leaves(), b, out);
+  // The search starts at the smallest cell holding the lattice units from one unit below b to
+  // one above (the margin dwarfs the rounding of the map to the lattice): every leaf that meets
+  // b is in it or holds it. From the root, a small box cost a binary search per level
+  // (segment_enters_kept, flange level 9: 15,000 instructions a query).
+  LatticePoint<Dim> x0, x1;
+  bool finite = true;
+  for (int d = 0; d < Dim; ++d) {
+    const double u0 = std::floor((b.lo[d] - t.root_box().lo[d]) / t.unit()) - 1.0;
+    const double u1 = std::floor((b.hi[d] - t.root_box().lo[d]) / t.unit()) + 1.0;
+    if (!(u0 <= u1)) {  // NaN or an empty box: the plain search decides
+      finite = false;
+      break;
+    }
+    const double top = double(root_length<Dim> - 1);
+    x0[d] = std::uint32_t(std::clamp(u0, 0.0, top));
+    x1[d] = std::uint32_t(std::clamp(u1, 0.0, top));
+  }
+  if (!finite) {
+    box_leaves(t, Cell<Dim>{}, 0, t.n_leaves(), b, out);
+    return out;
+  }
+  std::uint32_t differ = 0;
+  for (int d = 0; d < Dim; ++d) differ |= x0[d] ^ x1[d];
+  Cell<Dim> a;
+  a.level = std::uint8_t(max_level<Dim> - std::bit_width(differ));
+  for (int d = 0; d < Dim; ++d) a.anchor[d] = x0[d] & ~(length(a) - 1);
+  const CellKeys<Dim> keys{t};
+  const std::size_t j = covering_leaf(t, keys, a);
+  if (j != no_leaf) {
+    if (geometry(t, t.leaf(j)).overlaps(b)) out.push_back(j);
+    return out;
+  }
+  const std::size_t lo = first_at_or_after(keys, morton_key(a));
+  const std::size_t hi = lower_bound_key(keys, lo, keys.size(), morton_key(a) + volume_units(a));
+  box_leaves(t, a, lo, hi, b, out);
   return out;
 }
 

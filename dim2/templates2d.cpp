@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -261,13 +262,13 @@ TemplateCounts count_templates(const QuadrantComplex& qc, ElementKind kind) {
 
 void reserve(FeBeMesh& out, const TemplateCounts& n) {
   Mesh<2>& m = out.mesh;
-  m.points.reserve(n.points);
-  out.where.reserve(n.points);
-  m.solid.type.reserve(n.elements);
-  m.solid.offset.reserve(n.elements + 1);
-  m.solid.node.reserve(n.element_nodes);
-  m.level.reserve(n.elements);
-  m.from_boundary_cell.reserve(n.elements);
+  reserve_huge(m.points, n.points);
+  reserve_huge(out.where, n.points);
+  reserve_huge(m.solid.type, n.elements);
+  reserve_huge(m.solid.offset, n.elements + 1);
+  reserve_huge(m.solid.node, n.element_nodes);
+  reserve_huge(m.level, n.elements);
+  reserve_huge(m.from_boundary_cell, n.elements);
   m.interface.type.reserve(n.lines);
   m.interface.offset.reserve(n.lines + 1);
   m.interface.node.reserve(2 * n.lines);

@@ -49,6 +49,7 @@ TEMPLATE_TEST_CASE_SIG("cell family by hand", "[cell]", ((int Dim), Dim), 2, 3) 
   REQUIRE(point_from_key<Dim>(point_key<Dim>(top)) == top);
   REQUIRE(corner(root, Cube<Dim>::n_corners - 1) == top);
   REQUIRE(is_corner(root, top));
+  REQUIRE(corner_keys(root)[Cube<Dim>::n_corners - 1] == point_key<Dim>(top));
 }
 
 TEMPLATE_TEST_CASE_SIG("cell bit tricks agree with their slow twins", "[cell][property]", ((int Dim), Dim), 2, 3) {
@@ -56,6 +57,10 @@ TEMPLATE_TEST_CASE_SIG("cell bit tricks agree with their slow twins", "[cell][pr
     RC_ASSERT(is_valid(c));
     RC_ASSERT(morton_key(c) == morton_key_ref(c));
     RC_ASSERT(cell_from_key<Dim>(morton_key(c), c.level) == c);
+  });
+  test::prop("corner_keys are the corners' point keys", 200, [](const Cell<Dim>& c) {
+    const auto keys = corner_keys(c);
+    for (int k = 0; k < Cube<Dim>::n_corners; ++k) RC_ASSERT(keys[k] == point_key<Dim>(corner(c, k)));
   });
   test::prop("point keys round-trip up to root_length inclusive", 200, [](std::array<std::uint32_t, Dim> raw) {
     LatticePoint<Dim> p;

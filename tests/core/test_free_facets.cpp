@@ -43,3 +43,28 @@ TEMPLATE_TEST_CASE_SIG("update_free_facets gives free_facets after the change", 
     }
   });
 }
+
+TEMPLATE_TEST_CASE_SIG("free_facets skips only facets with kept leaves across", "[free_facets][property]", ((int Dim), Dim), 2,
+                       3) {
+  test::prop("against every leaf's facets searched", 50, [] {
+    const auto t = balance_2to1((*test::gen_recipe<Dim>()).build());
+    // Long runs of kept leaves (where the searches are skipped): those whose anchor lies in a
+    // ball around a random lattice point, some of them dropped.
+    const std::uint64_t salt = *rc::gen::inRange<std::uint64_t>(0, 1000);
+    const double radius = double(*rc::gen::inRange<int>(1, 100)) / 100.0 * double(root_length<Dim>);
+    Point<Dim> centre;
+    for (int d = 0; d < Dim; ++d) centre[d] = double(test::mix64(salt + d) % root_length<Dim>);
+    Flags keep(t.n_leaves());
+    for (std::size_t i = 0; i < t.n_leaves(); ++i) {
+      Point<Dim> a;
+      for (int d = 0; d < Dim; ++d) a[d] = double(t.leaf(i).anchor[d]);
+      keep[i] = (a - centre).norm() < radius && test::mix64(i + salt) % 100 < 97;
+    }
+    const LeafKeys<Dim> keys(t);
+    std::vector<std::size_t> all(t.n_leaves());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    std::vector<FreeFacet<Dim>> searched;
+    update_free_facets(t, keys, keep, all, searched);  // every kept leaf's facets searched
+    RC_ASSERT(same<Dim>(free_facets(t, keys, keep), searched));
+  });
+}

@@ -45,6 +45,7 @@ TEMPLATE_TEST_CASE_SIG("classification of analytic solids", "[orthtree][classify
     REQUIRE(std::count(sides.begin(), sides.end(), Side::Partial) > 0);
     REQUIRE(classify(tree, *b, 2) == sides);
     REQUIRE(classify(tree, *b, 3) == sides);
+    REQUIRE(classify_ref(tree, *b) == sides);
     // The paper's refinement puts the boundary in the finest cells: every PARTIAL leaf is at the
     // requested level.
     for (std::size_t i = 0; i < tree.n_leaves(); ++i) {
@@ -76,5 +77,6 @@ TEMPLATE_TEST_CASE_SIG("classification on random balls", "[orthtree][classify][p
       }
     }
     RC_ASSERT(classify(tree, ball, 2) == sides);
+    RC_ASSERT(classify_ref(tree, ball) == sides);
   });
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
@@ -134,6 +135,21 @@ TEMPLATE_TEST_CASE_SIG("queries agree with brute force", "[orthtree][queries][pr
       const double u = *rc::gen::inRange(0, 1001) / 1000.0, v = *rc::gen::inRange(0, 1001) / 1000.0;
       b.lo[d] = std::min(u, v) - 0.1;
       b.hi[d] = std::max(u, v);
+    }
+    std::vector<std::size_t> brute;
+    for (std::size_t i = 0; i < t.n_leaves(); ++i) {
+      if (geometry(t, t.leaf(i)).overlaps(b)) brute.push_back(i);
+    }
+    RC_ASSERT(leaves_in_box(t, b) == brute);
+  });
+  test::prop("leaves_in_box, small boxes on and near cell sides", 100, [] {
+    const auto t = (*test::gen_recipe<Dim>()).build();
+    Box<Dim> b;
+    const double size = std::ldexp(1.0, -*rc::gen::inRange(0, 12));
+    for (int d = 0; d < Dim; ++d) {
+      const double u = *rc::gen::inRange(-2, 1027) / 1024.0;  // on the lattice of level 10, or just off it
+      b.lo[d] = u - *rc::gen::inRange(0, 2) * 1e-12;
+      b.hi[d] = b.lo[d] + *rc::gen::inRange(0, 2) * size;
     }
     std::vector<std::size_t> brute;
     for (std::size_t i = 0; i < t.n_leaves(); ++i) {

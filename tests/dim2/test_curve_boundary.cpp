@@ -2,8 +2,10 @@
 // orientation and nesting, classify consistency, segments and control levels.
 
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
 
+#include "core/orthtree.hpp"
 #include "dim2/bezier.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/loop_geometry.hpp"
@@ -154,6 +156,17 @@ TEST_CASE("classify is consistent with is_inside and the crossing test", "[bound
     }
     RC_ASSERT(b.closest_point(c).distance > h);  // the box centre is farther than the box half-size
   });
+}
+
+TEST_CASE("the tree's top-down classification equals every leaf's own", "[boundary][classify]") {
+  const CurveBoundary b(test_domain());
+  const ControlFn<2> control = [&](const Box<2>& box) { return std::max(b.control_level(box), 7.0); };
+  const Orthtree<2> tree = balance_2to1(subdivide_by_control(b.root_box(), control));
+  const std::vector<Side> sides = classify(tree, b, 1);
+  CHECK(sides == classify_ref(tree, b));
+  CHECK(sides == classify(tree, b, 2));
+  CHECK(std::count(sides.begin(), sides.end(), Side::In) > 0);
+  CHECK(std::count(sides.begin(), sides.end(), Side::Partial) > 0);
 }
 
 TEST_CASE("segments: crossing, touching, and projection segments", "[boundary]") {
