@@ -54,6 +54,13 @@ class AabbTree {
   /// Calls f(t) for every triangle whose box meets the segment [a, b].
   template <class F> void for_each_on_segment(const P3& a, const P3& b, F&& f) const;
 
+  /// for_each_on_segment, less the triangles whose own box the segment misses: for callers
+  /// whose test is exact (segment_triangle), which finds no contact with those either (the
+  /// tree's nodes are pruned by the same padded slab test). A leaf's four triangles each cost
+  /// segment_triangle's two or five orient3d otherwise (is_inside: 428 M instructions at
+  /// sphere966 L5).
+  template <class F> void for_each_boxed_on_segment(const P3& a, const P3& b, F&& f) const;
+
   /// Does any triangle meet the closed box (exact separating-axis test on candidates)?
   bool overlaps(const Box<3>& box) const;
 
@@ -215,6 +222,24 @@ template <class F> void AabbTree::for_each_on_segment(const P3& a, const P3& b, 
     if (!segment_meets_box(a, b, node.box)) continue;
     if (node.count > 0) {
       for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
+    } else {
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
+    }
+  }
+}
+
+template <class F> void AabbTree::for_each_boxed_on_segment(const P3& a, const P3& b, F&& f) const {
+  if (nodes_.empty()) return;
+  std::array<std::int32_t, 128> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!segment_meets_box(a, b, node.box)) continue;
+    if (node.count > 0) {
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s)
+        if (segment_meets_box(a, b, boxes_[s])) f(ids_[s]);
     } else {
       stack[top++] = node.first + 1;
       stack[top++] = node.first;
