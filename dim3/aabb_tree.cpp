@@ -53,6 +53,13 @@ AabbTree::AabbTree(const std::vector<P3>& vertices, const std::vector<Triangle>&
     boxes_[s] = Box<3>::empty();
     for (const P3& q : points_[s]) boxes_[s].expand(q), coordinate = std::max(coordinate, q.cwiseAbs().maxCoeff());
   }
+  pair_boxes_.resize(nodes_.size() / 2);
+  for (std::size_t k = 0; k < pair_boxes_.size(); ++k)
+    for (int c = 0; c < 2; ++c)
+      for (int d = 0; d < 3; ++d) {
+        pair_boxes_[k].lo[d][c] = nodes_[2 * k + 1 + c].box.lo[d];
+        pair_boxes_[k].hi[d][c] = nodes_[2 * k + 1 + c].box.hi[d];
+      }
   const double scale = coordinate + nodes_[0].box.extent().norm();
   slack2_ = (1e-8 * scale) * (1e-8 * scale);
 }

@@ -252,7 +252,7 @@ bool SurfaceBoundary::segment_crosses(const P3& a, const P3& b) const {
   const P3 d = b - a;
   const P3 a1 = a + 1e-9 * d, b1 = b - 1e-9 * d;
   bool crosses = false;
-  tree_.for_each_on_segment(a1, b1, [&](std::int32_t t) {
+  tree_.for_each_boxed_on_segment(a1, b1, [&](std::int32_t t) {
     if (crosses) return;
     const auto& q = tree_.points(t);
     crosses = segment_triangle(a1, b1, q[0], q[1], q[2]) != Crossing::Miss;
@@ -297,7 +297,7 @@ bool SurfaceBoundary::is_inside(const P3& p) const {
     const P3 far = p + reach * dir;
     int hits = 0;
     bool degenerate = false;
-    tree_.for_each_on_segment(p, far, [&](std::int32_t t) {
+    tree_.for_each_boxed_on_segment(p, far, [&](std::int32_t t) {
       if (degenerate) return;
       const auto& q = tree_.points(t);
       const Crossing x = segment_triangle(p, far, q[0], q[1], q[2]);
