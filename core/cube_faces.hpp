@@ -4,6 +4,7 @@
 
 #include <array>
 
+#include "core/box.hpp"
 #include "core/cube.hpp"
 
 namespace febemesh {
@@ -29,5 +30,12 @@ template <> struct FaceCorners<3> {
       {4, 5, 7, 6},  // z-high
   }};
 };
+
+/// Outward unit normal of facet f of a cell: axis f / 2, towards lower coordinates for even f.
+template <int Dim> Point<Dim> facet_normal(int f) {
+  Point<Dim> n = Point<Dim>::Zero();
+  n[f / 2] = (f % 2) ? 1.0 : -1.0;
+  return n;
+}
 
 }  // namespace febemesh

@@ -363,19 +363,11 @@ namespace {
 std::vector<P3> ray_directions(std::uint8_t dirs) {
   std::vector<P3> rays;
   P3 sum = P3::Zero();
-  for (int f = 0; f < 6; ++f) {
-    if (!((dirs >> f) & 1)) continue;
-    P3 n = P3::Zero();
-    n[f / 2] = (f % 2) ? 1.0 : -1.0;
-    sum += n;
-  }
+  for (int f = 0; f < 6; ++f)
+    if ((dirs >> f) & 1) sum += facet_normal<3>(f);
   if (sum.norm() > 0) rays.push_back(sum.normalized());
-  for (int f = 0; f < 6; ++f) {
-    if (!((dirs >> f) & 1)) continue;
-    P3 n = P3::Zero();
-    n[f / 2] = (f % 2) ? 1.0 : -1.0;
-    rays.push_back(n);
-  }
+  for (int f = 0; f < 6; ++f)
+    if ((dirs >> f) & 1) rays.push_back(facet_normal<3>(f));
   return rays;
 }
 
@@ -889,7 +881,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
         P3 d = P3::Zero();
         for (std::int32_t q : sources[p - n_lat])
           for (int f = 0; f < Cube<3>::n_faces; ++f)
-            if (node_dirs[q] >> f & 1) d[f / 2] += f % 2 ? 1.0 : -1.0;
+            if (node_dirs[q] >> f & 1) d += facet_normal<3>(f);
         return d;
       };
       push_off_lines(s, oc, n_lat, hit, hit_line, surface_h, is_crowded, admissible_from_all, outward, opt.off_line,

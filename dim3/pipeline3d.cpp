@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/cube_faces.hpp"
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
 #include "core/quality.hpp"
@@ -151,8 +152,7 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
     if (oc.projection[q] >= 0) sources[oc.projection[q]].push_back(q);
   std::vector<P3> normal(n_lat, P3::Zero());
   for (const BoundaryOctant& b : oc.boundary) {
-    P3 n = P3::Zero();
-    n[b.face / 2] = (b.face % 2) ? 1.0 : -1.0;
+    const P3 n = facet_normal<3>(b.face);
     for (std::int32_t q : b.ring) normal[q] += n;
   }
   std::set<std::int32_t> movable;

@@ -33,6 +33,7 @@
 #include <set>
 #include <string>
 
+#include "core/cube_faces.hpp"
 #include "core/local_repair.hpp"
 #include "core/orthtree.hpp"
 #include "core/quality.hpp"
@@ -281,8 +282,7 @@ int main(int argc, char** argv) {
   }
   const auto classify_octant = [&](std::size_t k, bool print) {
     const BoundaryOctant& b = oc.boundary[k];
-    P3 nf = P3::Zero();
-    nf[b.face / 2] = (b.face % 2) ? 1.0 : -1.0;
+    const P3 nf = facet_normal<3>(b.face);
     const double h = length(b.cell) * tree.unit();
     int why = 3;
     for (std::int32_t q : b.ring) {
