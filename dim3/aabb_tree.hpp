@@ -83,6 +83,10 @@ class AabbTree {
   Closest closest_within(const P3& p, double bound, Skip&& skip, std::int32_t known_slot = -1,
                          const TrianglePoint* known = nullptr) const;
 
+  /// The tree walk of the for_each_* queries: f(t) for the triangles of every leaf whose
+  /// node boxes all meet (meets(box)), and with `triangle_boxes` whose own box meets too.
+  template <class Meets, class F> void walk(const Meets& meets, bool triangle_boxes, F&& f) const;
+
   std::vector<Node> nodes_;
   std::vector<std::int32_t> ids_;             ///< triangle index in slot order
   std::vector<std::int32_t> slot_;            ///< slot of each triangle
@@ -177,74 +181,39 @@ AabbTree::Closest AabbTree::closest_within(const P3& p, double bound, Skip&& ski
   return best;
 }
 
-template <class F> void AabbTree::for_each_near(const P3& p, double radius, F&& f) const {
+template <class Meets, class F> void AabbTree::walk(const Meets& meets, bool triangle_boxes, F&& f) const {
   if (nodes_.empty()) return;
-  const double r2 = radius * radius;
   std::array<std::int32_t, 128> stack;
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (box_distance2(node.box, p) > r2) continue;
+    if (!meets(node.box)) continue;
     if (node.count > 0) {
-      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
+      for (std::int32_t s = node.first; s < node.first + node.count; ++s)
+        if (!triangle_boxes || meets(boxes_[s])) f(ids_[s]);
     } else {
       stack[top++] = node.first + 1;
       stack[top++] = node.first;
     }
   }
+}
+
+template <class F> void AabbTree::for_each_near(const P3& p, double radius, F&& f) const {
+  const double r2 = radius * radius;
+  walk([&](const Box<3>& b) { return !(box_distance2(b, p) > r2); }, false, f);
 }
 
 template <class F> void AabbTree::for_each_in_box(const Box<3>& box, F&& f) const {
-  if (nodes_.empty()) return;
-  std::array<std::int32_t, 128> stack;
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!node.box.overlaps(box)) continue;
-    if (node.count > 0) {
-      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
-    } else {
-      stack[top++] = node.first + 1;
-      stack[top++] = node.first;
-    }
-  }
+  walk([&](const Box<3>& b) { return b.overlaps(box); }, false, f);
 }
 
 template <class F> void AabbTree::for_each_on_segment(const P3& a, const P3& b, F&& f) const {
-  if (nodes_.empty()) return;
-  std::array<std::int32_t, 128> stack;
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!segment_meets_box(a, b, node.box)) continue;
-    if (node.count > 0) {
-      for (std::int32_t s = node.first; s < node.first + node.count; ++s) f(ids_[s]);
-    } else {
-      stack[top++] = node.first + 1;
-      stack[top++] = node.first;
-    }
-  }
+  walk([&](const Box<3>& box) { return segment_meets_box(a, b, box); }, false, f);
 }
 
 template <class F> void AabbTree::for_each_boxed_on_segment(const P3& a, const P3& b, F&& f) const {
-  if (nodes_.empty()) return;
-  std::array<std::int32_t, 128> stack;
-  int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!segment_meets_box(a, b, node.box)) continue;
-    if (node.count > 0) {
-      for (std::int32_t s = node.first; s < node.first + node.count; ++s)
-        if (segment_meets_box(a, b, boxes_[s])) f(ids_[s]);
-    } else {
-      stack[top++] = node.first + 1;
-      stack[top++] = node.first;
-    }
-  }
+  walk([&](const Box<3>& box) { return segment_meets_box(a, b, box); }, true, f);
 }
 
 }  // namespace febemesh::dim3

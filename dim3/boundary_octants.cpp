@@ -55,6 +55,18 @@ unsigned kept_mask(const std::array<std::size_t, 8>& around, const Flags& in) {
   return kept;
 }
 
+/// Clears in[i] for the leaves in `drop` (no_leaf and repeats allowed); returns how many were set.
+std::size_t unkeep(const std::vector<std::size_t>& drop, Flags& in) {
+  std::size_t n = 0;
+  for (std::size_t i : drop) {
+    if (i != no_leaf && in[i]) {
+      in[i] = 0;
+      ++n;
+    }
+  }
+  return n;
+}
+
 /// Face-connected components of the octants in `mask` within the 2x2x2 block (octants are
 /// face-adjacent when their indices differ in one bit). comp[o] = component or -1.
 int components(unsigned mask, std::array<int, 8>& comp) {
@@ -142,15 +154,7 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
         }
       }
     }
-    std::sort(drop.begin(), drop.end());
-    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
-    std::size_t n = 0;
-    for (std::size_t i : drop) {
-      if (i != no_leaf && in[i]) {
-        in[i] = 0;
-        ++n;
-      }
-    }
+    const std::size_t n = unkeep(drop, in);
     removed += n;
     if (n == 0) break;
   }
@@ -199,15 +203,7 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
         break;
       }
     }
-    std::sort(drop.begin(), drop.end());
-    drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
-    std::size_t n = 0;
-    for (std::size_t i : drop) {
-      if (in[i]) {
-        in[i] = 0;
-        ++n;
-      }
-    }
+    const std::size_t n = unkeep(drop, in);
     removed += n;
     if (n == 0) break;
   }
