@@ -96,9 +96,12 @@ TriangleSoup read_off(std::istream& in, const std::string& name) {
   constexpr long long max_count = 1LL << 28;
   if (nv > max_count || nf > max_count) fail(name, first_line, "vertex or face count too large");
 
+  // Each vertex and face takes a line of its own: reserve no more than the file has lines for
+  // (a header of a small file may declare 2^28 faces; fuzz_off: a 2.7 GB reserve).
+  const auto remaining = static_cast<long long>(lines.items.size() - lines.next);
   TriangleSoup soup;
-  soup.vertices.reserve(nv);
-  soup.triangles.reserve(nf);
+  soup.vertices.reserve(static_cast<std::size_t>(std::min(nv, remaining)));
+  soup.triangles.reserve(static_cast<std::size_t>(std::min(nf, remaining)));
   auto truncated = [&](const std::string& what, long long found) {
     const int last = lines.items.empty() ? 0 : lines.items.back().second;
     fail(name, last,
