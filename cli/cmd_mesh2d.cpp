@@ -55,7 +55,8 @@ options:
                         figures/README.txt saying why (SVGs of 10^5 quadrants are unreadable,
                         tens of MB, and took longer to write than the mesh)
   --no-figures          same as --figures none
-  --binary              write mesh.msh as MSH 4.1 binary (smaller, faster to write and read)
+  --binary              write mesh.msh as MSH 4.1 binary (faster to write and read, not
+                        smaller: every tag takes 8 bytes)
   --no-validate         skip the final validation (benchmarks)
   --quiet               no progress on stderr
 

@@ -197,6 +197,12 @@ int main(int argc, char** argv) {
   }
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--opposing") opt.drop_opposing = true;
+  for (int i = 1; i < argc; ++i) {
+    // --single: one try, no fallbacks (buffer, feature snapping, facing projections, level raise)
+    if (std::string(argv[i]) == "--single")
+      opt.retry_facing = false, opt.retry_without_buffer = false, opt.raise_levels = 0, opt.thin_retry_cells = 0;
+    if (std::string(argv[i]) == "--nosnap") opt.snap_features = false;
+  }
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--thin-share") {
       // Share of the surface thinner than k octants of the global level (the thin-first rule).
