@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <queue>
 #include <utility>
 
 #include "core/error.hpp"
@@ -251,14 +252,14 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   const double below = opt.below_deg * pi / 180.0;
   // Worst first; new tetrahedra below the bar join the list (each removal raises the worst
   // angle around its edge, so this ends; the cap is a guard).
-  std::vector<std::pair<double, std::int32_t>> todo;
+  using Entry = std::pair<double, std::int32_t>;  // (quality, tetrahedron): the worst on top
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> todo;
   for (std::size_t t = 0; t < w.tets.size(); ++t)
-    if (w.q[t] < below) todo.push_back({w.q[t], static_cast<std::int32_t>(t)});
+    if (w.q[t] < below) todo.push({w.q[t], static_cast<std::int32_t>(t)});
   const std::size_t cap = 8 * todo.size() + 16;
   for (std::size_t round = 0; !todo.empty() && round < cap; ++round) {
-    std::sort(todo.begin(), todo.end(), std::greater<>());
-    const std::int32_t t = todo.back().second;
-    todo.pop_back();
+    const std::int32_t t = todo.top().second;
+    todo.pop();
     if (!w.alive[t] || !(w.q[t] > 0)) continue;
     const std::size_t first_new = w.tets.size();
     const Tet n = w.tets[t];
@@ -266,7 +267,7 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
     for (int i = 0; i < 4 && !done; ++i)
       for (int j = i + 1; j < 4 && !done; ++j) done = w.try_remove(n[i], n[j], st);
     for (std::size_t k = first_new; k < w.tets.size(); ++k)
-      if (w.q[k] < below) todo.push_back({w.q[k], static_cast<std::int32_t>(k)});
+      if (w.q[k] < below) todo.push({w.q[k], static_cast<std::int32_t>(k)});
   }
   if (st.removed == 0) return st;
   // Write back: survivors in order, then the new ones.

@@ -23,7 +23,7 @@ namespace febemesh::dim3 {
 
 struct EdgeRemovalOptions {
   /// Edges of tetrahedra whose smallest dihedral angle is below this (degrees) are tried.
-  double below_deg = 15.0;
+  double below_deg = 30.0;
   /// Links of more nodes are not tried (the programme is cubic in them).
   int max_link = 8;
   /// A removal is taken if it raises the worst dihedral angle of the tetrahedra it replaces by

@@ -882,10 +882,12 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         if (opt.remove_edges_below_deg > 0 && !opt.hex_dominant) {
           // Node moves stall where the connectivity fixes a wedge (anchor L5: four tetrahedra
           // around a surface edge whose triangles meet at 62 deg, five under 10 deg). Measured
-          // (CLI, min dihedral deg): anchor L5 9.45 -> 11.69 with one round, 12.20 with three;
-          // anchor L4 12.73 -> 16.70, fandisk L4 13.18 -> 14.33 (one or three rounds), elephant L4
-          // 13.80 -> 16.78 (one round);
-          // sphere966, spool, rotor L4 unchanged.
+          // (CLI, min dihedral deg, base -> edges under 15 deg -> under 30): anchor L5 9.45 ->
+          // 12.20 -> 14.38; L4: sphere966 28.17 -> 28.17 -> 29.93, spool 14.30 (unchanged),
+          // anchor 12.73 -> 16.70 -> 19.56 (25 deg: 19.96, anchor L5 12.81), fandisk 13.18 ->
+          // 14.33 -> 14.34, rotor 16.73 -> 16.73 -> 17.60, elephant 13.80 -> 16.78 (one round) ->
+          // 21.42. Volume and Hausdorff errors the same to 3 digits; CPU about the same (30 deg
+          // with a sort per removal instead of a heap: anchor L5 14.3 s instead of 6.5).
           EdgeRemovalOptions eo;
           eo.below_deg = opt.remove_edges_below_deg;
           eo.surface_normal = surface_normal;

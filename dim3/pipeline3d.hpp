@@ -73,7 +73,7 @@ struct Options3d {
   /// that raises the worst angle around them (dim3/edge_removal.hpp), then one more sweep
   /// pass; up to three rounds while edges go. 0 = none. Not with hex_dominant (it merges the
   /// templates' tetrahedra).
-  double remove_edges_below_deg = 15.0;
+  double remove_edges_below_deg = 30.0;  // the sweeps' target_dihedral_deg
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Repairs that may leave more problems than the tree before them: a try stops at the next
   /// one that does ("the last one made it worse"). Refining around inverted tetrahedra moves
