@@ -69,6 +69,11 @@ struct Options3d {
   double target_dihedral_deg = 30.0; ///< nodes whose tets all reach this angle are left alone
   /// In those sweeps, nodes snapped onto a feature line slide along it (else they stay put).
   bool slide_feature_nodes = true;
+  /// After those sweeps, edges of tetrahedra under this angle (degrees) are removed where
+  /// that raises the worst angle around them (dim3/edge_removal.hpp), then one more sweep
+  /// pass; up to three rounds while edges go. 0 = none. Not with hex_dominant (it merges the
+  /// templates' tetrahedra).
+  double remove_edges_below_deg = 30.0;  // the sweeps' target_dihedral_deg
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Repairs that may leave more problems than the tree before them: a try stops at the next
   /// one that does ("the last one made it worse"). Refining around inverted tetrahedra moves
@@ -152,6 +157,7 @@ struct Result3d {
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
   std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
+  std::size_t n_edges_removed = 0;   ///< edges removed after it (remove_edges_below_deg)
   HexDominantStats hex;              ///< with opt.hex_dominant
   std::vector<StageTime3> times;
 };

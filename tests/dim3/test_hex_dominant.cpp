@@ -180,6 +180,7 @@ TEST_CASE("hex-dominant merges keep the smallest dihedral angle of the tets (rot
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/rotor.off");
   Options3d opt;
   opt.level = 3;
+  opt.remove_edges_below_deg = 0.0;  // the tetrahedra the merges start from
   const double tet = summarize_quality<3>(mesh3d(s, opt).fe.mesh).min_angle_deg;
   opt.hex_dominant = true;
   const Result3d r = mesh3d(s, opt);
@@ -308,6 +309,8 @@ TEST_CASE("hex-dominant meshes of tori and voxel unions are valid when the tet m
       SurfaceBoundary s(std::move(surface));
       Options3d opt;
       opt.level = spec.level;
+      // The tetrahedra hex_dominant merges: without edge removal, which it does not take.
+      opt.remove_edges_below_deg = 0.0;
       Result3d tet;
       try {
         tet = mesh3d(s, opt);

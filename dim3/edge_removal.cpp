@@ -1,0 +1,296 @@
+#include "dim3/edge_removal.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <queue>
+#include <utility>
+
+#include "core/error.hpp"
+#include "dim3/tet_optimize.hpp"
+
+namespace febemesh::dim3 {
+namespace {
+
+using P3 = Point<3>;
+using Tet = std::array<std::int32_t, 4>;
+using Tri = std::array<std::int32_t, 3>;
+
+constexpr double pi = 3.14159265358979323846;
+constexpr double none = -std::numeric_limits<double>::infinity();
+
+double orient(const P3& a, const P3& b, const P3& c, const P3& d) { return (b - a).dot((c - a).cross(d - a)); }
+
+/// The mesh as lists that removals edit: dead entries stay until `write_back`.
+struct Work {
+  Mesh<3>& mesh;
+  const std::vector<BoundaryLocation>& where;
+  const EdgeRemovalOptions& opt;
+  std::vector<Tet> tets;
+  std::vector<std::uint8_t> alive;
+  std::vector<double> q;  ///< tet_search_quality (radians when positive)
+  std::vector<std::uint8_t> level, from_boundary;
+  std::vector<std::int32_t> cell;
+  std::vector<std::vector<std::int32_t>> node_tets;
+  std::vector<Tri> faces;
+  std::vector<std::uint8_t> face_alive;
+  std::vector<std::vector<std::int32_t>> node_faces;
+
+  double quality(const Tet& t) const {
+    return tet_search_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+  }
+  bool is_feature(std::int32_t v) const {
+    return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0 &&
+           where[v].kind != BoundaryLocation::Kind::Smooth;
+  }
+  bool connected(std::int32_t u, std::int32_t v) const {
+    for (const std::int32_t t : node_tets[u])
+      if (alive[t] && std::find(tets[t].begin(), tets[t].end(), v) != tets[t].end()) return true;
+    return false;
+  }
+  /// Smallest cosine between triangle f's normal and the surface normals at its nodes.
+  double fit(const Tri& f) const {
+    double c = 1.0;
+    for (const std::int32_t v : f)
+      c = std::min(c, surface_alignment(mesh.points[f[0]], mesh.points[f[1]], mesh.points[f[2]], opt.surface_normal(where[v])));
+    return c;
+  }
+  /// f ordered so that its normal points away from node o.
+  Tri outward(Tri f, std::int32_t o) const {
+    if (orient(mesh.points[f[0]], mesh.points[f[1]], mesh.points[f[2]], mesh.points[o]) > 0) std::swap(f[1], f[2]);
+    return f;
+  }
+
+  std::int32_t add_tet(const Tet& t, std::int32_t like) {
+    const auto id = static_cast<std::int32_t>(tets.size());
+    tets.push_back(t);
+    alive.push_back(1);
+    q.push_back(quality(t));
+    if (!level.empty()) level.push_back(level[like]);
+    if (!from_boundary.empty()) from_boundary.push_back(from_boundary[like]);
+    if (!cell.empty()) cell.push_back(cell[like]);
+    for (const std::int32_t v : t) node_tets[v].push_back(id);
+    return id;
+  }
+  void kill_tet(std::int32_t t) {
+    alive[t] = 0;
+    for (const std::int32_t v : tets[t]) {
+      auto& l = node_tets[v];
+      l.erase(std::find(l.begin(), l.end(), t));
+    }
+  }
+  void add_face(const Tri& f) {
+    const auto id = static_cast<std::int32_t>(faces.size());
+    faces.push_back(f);
+    face_alive.push_back(1);
+    for (const std::int32_t v : f) node_faces[v].push_back(id);
+  }
+  void kill_face(std::int32_t f) {
+    face_alive[f] = 0;
+    for (const std::int32_t v : faces[f]) {
+      auto& l = node_faces[v];
+      l.erase(std::find(l.begin(), l.end(), f));
+    }
+  }
+
+  /// Removes edge ab if a triangulation of its link raises the worst angle around it by
+  /// opt.min_gain_deg; returns whether it did.
+  bool try_remove(std::int32_t a, std::int32_t b, EdgeRemovalStats& st) {
+    // The tetrahedra around ab, each as a link edge c -> d with (a, b, c, d) positive.
+    std::vector<std::int32_t> around;
+    std::vector<std::pair<std::int32_t, std::int32_t>> link;
+    double old_min = std::numeric_limits<double>::infinity();
+    for (const std::int32_t t : node_tets[a]) {
+      const Tet& n = tets[t];
+      int i = -1, j = -1;
+      for (int k = 0; k < 4; ++k) i = n[k] == a ? k : i, j = n[k] == b ? k : j;
+      if (j < 0) continue;
+      std::array<int, 4> perm = {i, j, -1, -1};
+      for (int k = 0, m = 2; k < 4; ++k)
+        if (k != i && k != j) perm[m++] = k;
+      int inversions = 0;
+      for (int x = 0; x < 4; ++x)
+        for (int y = x + 1; y < 4; ++y) inversions += perm[x] > perm[y] ? 1 : 0;
+      std::int32_t c = n[perm[2]], d = n[perm[3]];
+      if (inversions % 2 == 1) std::swap(c, d);
+      around.push_back(t);
+      link.push_back({c, d});
+      old_min = std::min(old_min, q[t]);
+    }
+    const int n_tets = static_cast<int>(around.size());
+    if (n_tets < 2 || n_tets + 1 > opt.max_link) return false;
+    // Chain the link edges: a cycle inside, a path at the surface.
+    std::vector<std::int32_t> ring;
+    {
+      std::int32_t start = link[0].first;
+      for (const auto& [c, d] : link) {
+        (void)d;
+        if (std::none_of(link.begin(), link.end(), [&](const auto& e) { return e.second == c; })) start = c;
+      }
+      ring.push_back(start);
+      for (int k = 0; k < n_tets; ++k) {
+        const auto it = std::find_if(link.begin(), link.end(), [&](const auto& e) { return e.first == ring.back(); });
+        if (it == link.end()) return false;
+        ring.push_back(it->second);
+      }
+    }
+    const bool closed = ring.back() == ring.front();
+    if (closed) ring.pop_back();
+    const int m = static_cast<int>(ring.size());
+    {
+      std::vector<std::int32_t> sorted = ring;
+      std::sort(sorted.begin(), sorted.end());
+      if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) return false;  // not a simple link
+    }
+    // The interface triangles at ab: none inside, the two at the path's ends at the surface.
+    std::vector<std::int32_t> at_ab;
+    for (const std::int32_t f : node_faces[a])
+      if (std::find(faces[f].begin(), faces[f].end(), b) != faces[f].end()) at_ab.push_back(f);
+    if (closed != at_ab.empty()) return false;
+    double old_fit = 0.0;
+    if (!closed) {
+      if (!opt.surface_normal || at_ab.size() != 2 || (is_feature(a) && is_feature(b))) return false;
+      const auto has = [&](std::int32_t f, std::int32_t v) { return std::find(faces[f].begin(), faces[f].end(), v) != faces[f].end(); };
+      if (!((has(at_ab[0], ring.front()) && has(at_ab[1], ring.back())) ||
+            (has(at_ab[1], ring.front()) && has(at_ab[0], ring.back()))))
+        return false;
+      // Only a convex edge of the surface mesh: the new tetrahedra then fill less than the old
+      // ones (not the tetrahedron a b ring.front() ring.back()) and reach nothing outside them.
+      const P3* p = mesh.points.data();
+      if (!(orient(p[a], p[b], p[ring.front()], p[ring.back()]) > 0)) return false;
+      if (connected(ring.front(), ring.back())) return false;
+      old_fit = std::min(fit(faces[at_ab[0]]), fit(faces[at_ab[1]]));
+    }
+    // Klincsek: best[i][k] the best worst angle triangulating ring[i..k] (i < k).
+    const auto q3 = [&](int i, int j, int k) {
+      const double qa = quality({a, ring[i], ring[j], ring[k]});
+      const double qb = quality({b, ring[k], ring[j], ring[i]});
+      return qa > 0 && qb > 0 ? std::min(qa, qb) : none;
+    };
+    std::vector<double> best(static_cast<std::size_t>(m * m), std::numeric_limits<double>::infinity());
+    std::vector<int> split(static_cast<std::size_t>(m * m), -1);
+    for (int len = 2; len < m; ++len)
+      for (int i = 0; i + len < m; ++i) {
+        const int k = i + len;
+        double& bk = best[i * m + k];
+        bk = none;
+        for (int j = i + 1; j < k; ++j) {
+          const double v = std::min({best[i * m + j], best[j * m + k], q3(i, j, k)});
+          if (v > bk) bk = v, split[i * m + k] = j;
+        }
+      }
+    const double new_min = best[m - 1];
+    if (!(new_min > old_min + opt.min_gain_deg * pi / 180.0)) return false;
+    std::vector<std::array<int, 3>> tris;
+    std::vector<std::pair<int, int>> stack = {{0, m - 1}};
+    while (!stack.empty()) {
+      const auto [i, k] = stack.back();
+      stack.pop_back();
+      if (k - i < 2) continue;
+      const int j = split[i * m + k];
+      tris.push_back({i, j, k});
+      stack.push_back({i, j});
+      stack.push_back({j, k});
+    }
+    // New edges must be new: the diagonals of the triangulation.
+    for (const auto& t : tris)
+      for (int e = 0; e < 3; ++e) {
+        const int u = t[e], v = t[(e + 1) % 3];
+        const bool side = v == u + 1 || u == v + 1 || (closed && std::abs(u - v) == m - 1);
+        if (!side && !(u == 0 && v == m - 1) && !(u == m - 1 && v == 0) && connected(ring[u], ring[v])) return false;
+      }
+    std::array<Tri, 2> new_faces{};
+    if (!closed) {
+      // The triangle with the chord ring.front() ring.back() is tris[0] (the root split).
+      const std::int32_t o = ring[tris[0][1]];
+      new_faces[0] = outward({a, ring.front(), ring.back()}, o);
+      new_faces[1] = outward({b, ring.front(), ring.back()}, o);
+      const double new_fit = std::min(fit(new_faces[0]), fit(new_faces[1]));
+      if (!(new_fit > 0 && new_fit >= old_fit)) return false;
+    }
+    const std::int32_t like = around[0];
+    for (const auto& t : tris) {
+      add_tet({a, ring[t[0]], ring[t[1]], ring[t[2]]}, like);
+      add_tet({b, ring[t[2]], ring[t[1]], ring[t[0]]}, like);
+    }
+    for (const std::int32_t t : around) kill_tet(t);
+    if (!closed) {
+      for (const std::int32_t f : at_ab) kill_face(f);
+      add_face(new_faces[0]);
+      add_face(new_faces[1]);
+      ++st.surface_swapped;
+    }
+    ++st.removed;
+    return true;
+  }
+};
+
+}  // namespace
+
+EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
+                                  const EdgeRemovalOptions& opt) {
+  Work w{mesh, where, opt, {}, {}, {}, mesh.level, mesh.from_boundary_cell, cell ? *cell : std::vector<std::int32_t>{}, {}, {}, {}, {}};
+  const std::size_t n = mesh.points.size();
+  w.node_tets.resize(n);
+  w.node_faces.resize(n);
+  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
+    MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "remove_bad_edges needs tetrahedra");
+    const VertexId* v = mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const Tet t = {v[0].v, v[1].v, v[2].v, v[3].v};
+    w.tets.push_back(t);
+    w.alive.push_back(1);
+    w.q.push_back(w.quality(t));
+    for (const std::int32_t u : t) w.node_tets[u].push_back(static_cast<std::int32_t>(e));
+  }
+  for (std::size_t f = 0; f < mesh.interface.size(); ++f) {
+    MESH_ASSERT(mesh.interface.type[f] == ElemType::Tri3, "remove_bad_edges needs interface triangles");
+    const VertexId* v = mesh.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+    w.add_face({v[0].v, v[1].v, v[2].v});
+  }
+  EdgeRemovalStats st;
+  const double below = opt.below_deg * pi / 180.0;
+  // Worst first; new tetrahedra below the bar join the list (each removal raises the worst
+  // angle around its edge, so this ends; the cap is a guard).
+  using Entry = std::pair<double, std::int32_t>;  // (quality, tetrahedron): the worst on top
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> todo;
+  for (std::size_t t = 0; t < w.tets.size(); ++t)
+    if (w.q[t] < below) todo.push({w.q[t], static_cast<std::int32_t>(t)});
+  const std::size_t cap = 8 * todo.size() + 16;
+  for (std::size_t round = 0; !todo.empty() && round < cap; ++round) {
+    const std::int32_t t = todo.top().second;
+    todo.pop();
+    if (!w.alive[t] || !(w.q[t] > 0)) continue;
+    const std::size_t first_new = w.tets.size();
+    const Tet n = w.tets[t];
+    bool done = false;
+    for (int i = 0; i < 4 && !done; ++i)
+      for (int j = i + 1; j < 4 && !done; ++j) done = w.try_remove(n[i], n[j], st);
+    for (std::size_t k = first_new; k < w.tets.size(); ++k)
+      if (w.q[k] < below) todo.push({w.q[k], static_cast<std::int32_t>(k)});
+  }
+  if (st.removed == 0) return st;
+  // Write back: survivors in order, then the new ones.
+  Elements solid;
+  std::vector<std::uint8_t> level, from_boundary;
+  std::vector<std::int32_t> cells;
+  for (std::size_t t = 0; t < w.tets.size(); ++t) {
+    if (!w.alive[t]) continue;
+    const Tet& v = w.tets[t];
+    solid.add(ElemType::Tet4, {VertexId{v[0]}, VertexId{v[1]}, VertexId{v[2]}, VertexId{v[3]}});
+    if (!w.level.empty()) level.push_back(w.level[t]);
+    if (!w.from_boundary.empty()) from_boundary.push_back(w.from_boundary[t]);
+    if (!w.cell.empty()) cells.push_back(w.cell[t]);
+  }
+  Elements interface;
+  for (std::size_t f = 0; f < w.faces.size(); ++f)
+    if (w.face_alive[f]) interface.add(ElemType::Tri3, {VertexId{w.faces[f][0]}, VertexId{w.faces[f][1]}, VertexId{w.faces[f][2]}});
+  mesh.solid = std::move(solid);
+  mesh.interface = std::move(interface);
+  mesh.level = std::move(level);
+  mesh.from_boundary_cell = std::move(from_boundary);
+  if (cell) *cell = std::move(cells);
+  return st;
+}
+
+}  // namespace febemesh::dim3

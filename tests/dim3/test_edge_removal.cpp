@@ -1,0 +1,169 @@
+// edge_removal: removing an edge keeps the region filled (inside: the same volume; at a convex
+// surface edge: less by the tetrahedron cut off), inverts nothing and raises the worst angle; the
+// surface edge of anchor level 5 that held its five tetrahedra under 10 deg is swapped.
+
+#include <catch2/catch.hpp>
+#include <rapidcheck.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+
+#include "core/mesh.hpp"
+#include "core/read_msh.hpp"
+#include "core/test_mesh_fixtures.hpp"
+#include "dim3/edge_removal.hpp"
+#include "dim3/tet_optimize.hpp"
+#include "property.hpp"
+#include "test_paths.hpp"
+
+using namespace febemesh;
+using namespace febemesh::dim3;
+
+namespace {
+
+using P3 = Point<3>;
+
+double volume6(const Mesh<3>& m, std::size_t e) {
+  const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+  const P3 &a = m.points[v[0].v], &b = m.points[v[1].v], &c = m.points[v[2].v], &d = m.points[v[3].v];
+  return (b - a).dot((c - a).cross(d - a));
+}
+double total_volume6(const Mesh<3>& m) {
+  double s = 0.0;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) s += volume6(m, e);
+  return s;
+}
+double min_dihedral(const Mesh<3>& m) {
+  double lo = 180.0;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    lo = std::min(lo, tet_min_dihedral_deg(m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]));
+  }
+  return lo;
+}
+/// Every face of the tetrahedra seen once from each side, or once from one (the hull).
+bool faces_match(const Mesh<3>& m) {
+  std::map<std::array<std::int32_t, 3>, int> seen;  // sorted face -> +1 / -1 per orientation
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    for (const auto& f : face) {
+      std::array<std::int32_t, 3> k = {v[f[0]].v, v[f[1]].v, v[f[2]].v};
+      // Orientation sign: the parity of the sort.
+      int swaps = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j + 1 < 3 - i; ++j)
+          if (k[j] > k[j + 1]) std::swap(k[j], k[j + 1]), ++swaps;
+      int& s = seen[k];
+      if (s != 0 && (s > 0) == (swaps % 2 == 0)) return false;  // the same side twice
+      s += swaps % 2 == 0 ? 1 : -1;
+      if (std::abs(s) > 1) return false;
+    }
+  }
+  return true;
+}
+
+/// The tetrahedra at nodes 22900, 35632, 35635 and 67692 of anchor level 5 (CLI, before edge
+/// removal; regressions/anchor-L5-ridge.msh, renumbered) with their interface triangles: its five
+/// tetrahedra under 10 deg sit around the surface edge 35632-35635, from the concave feature
+/// line's face z = 0.0217 to its face y = 0.2, whose interface triangles meet at 62 deg. Surface
+/// nodes: patch 0 on the face z = 0.0217, 1 on y = 0.2.
+Mesh<3> anchor_ridge(std::vector<BoundaryLocation>& where) {
+  Mesh<3> m = read_msh<3>(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/anchor-L5-ridge.msh");
+  where.assign(m.points.size(), BoundaryLocation{});
+  for (const VertexId v : m.interface.node) {
+    const P3& x = m.points[v.v];
+    where[v.v].patch = std::abs(x[2] - 0.0217069) < 1e-12 ? 0 : std::abs(x[1] - 0.2) < 1e-12 ? 1 : -2;
+  }
+  return m;
+}
+P3 anchor_normal(const BoundaryLocation& w) { return w.patch == 0 ? P3(0, 0, 1) : P3(0, 1, 0); }
+
+}  // namespace
+
+TEST_CASE("edge removal mends the anchor L5 surface edge that no node move can", "[edge_removal]") {
+  std::vector<BoundaryLocation> where;
+  Mesh<3> m = anchor_ridge(where);
+  for (const BoundaryLocation& w : where) REQUIRE(w.patch >= -1);  // every surface node on a face
+  const double before = min_dihedral(m), vol = total_volume6(m);
+  const std::size_t n_interface = m.interface.size();
+  CHECK(before < 9.5);
+  std::vector<std::int32_t> cell(m.solid.size());
+  for (std::size_t e = 0; e < cell.size(); ++e) cell[e] = static_cast<std::int32_t>(e);
+  // The optimiser may move the two inside nodes whose tetrahedra are all here (22900, 67692);
+  // the surface nodes stay (no projection), and so do the nodes at the cut.
+  TetOptimizeOptions to;
+  to.target_dihedral_deg = 20.0;
+  to.fixed.assign(m.points.size(), 1);
+  to.fixed[6] = to.fixed[46] = 0;
+  REQUIRE(m.points[6].isApprox(P3(0.1642021294999, 0.19387797815118168, 0.008571711993674942)));
+  REQUIRE(m.points[46].isApprox(P3(0.18007276780393308, 0.18633886087132615, 0.013278694732051252)));
+
+  SECTION("node moves alone do not get there") {
+    optimize_tets(m, where, to);
+    CHECK(min_dihedral(m) < 10.0);
+  }
+  SECTION("without surface normals surface edges stay") {
+    const EdgeRemovalStats st = remove_bad_edges(m, where, &cell, EdgeRemovalOptions{});
+    CHECK(st.removed >= 1);
+    CHECK(st.surface_swapped == 0);
+    CHECK(m.interface.size() == n_interface);
+    CHECK(std::abs(total_volume6(m) - vol) <= 1e-12 * vol);
+    CHECK(faces_match(m));
+  }
+  SECTION("with them the surface edge is swapped and no tetrahedron stays under 10 deg") {
+    EdgeRemovalOptions eo;
+    eo.surface_normal = anchor_normal;
+    const EdgeRemovalStats st = remove_bad_edges(m, where, &cell, eo);
+    CHECK(st.surface_swapped >= 1);
+    CHECK(cell.size() == m.solid.size());
+    for (std::size_t e = 0; e < m.solid.size(); ++e) CHECK(volume6(m, e) > 0);
+    const double removed = min_dihedral(m);
+    optimize_tets(m, where, to);
+    const double after = min_dihedral(m);
+    INFO("min dihedral " << before << " -> " << removed << " (edges removed: " << st.removed << ") -> " << after
+                         << " deg (optimised)");
+    CHECK(after >= 10.0);
+    CHECK(faces_match(m));
+    // A swap cuts the ridge's tetrahedron off: less volume, the same number of interface triangles.
+    CHECK(total_volume6(m) < vol);
+    CHECK(total_volume6(m) > 0.99 * vol);
+    CHECK(m.interface.size() == n_interface);
+    for (std::size_t f = 0; f < m.interface.size(); ++f) {
+      const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+      P3 ref = P3::Zero();
+      for (int k = 0; k < 3; ++k) ref += anchor_normal(where[v[k].v]);
+      CHECK(surface_alignment(m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], ref) > 0);
+    }
+  }
+}
+
+TEST_CASE("edge removal inside a jittered cube keeps the volume and raises the worst angle", "[edge_removal][property]") {
+  test::prop("jittered Kuhn cubes", 20, [](unsigned seed) {
+    Mesh<3> m = test::grid_mesh<3>(3, true);
+    m.interface.clear();
+    m.level.clear();
+    m.from_boundary_cell.clear();
+    std::uint64_t s = seed;
+    const auto rnd = [&] {
+      s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+      return double(s >> 11) / double(1ULL << 53) - 0.5;
+    };
+    for (P3& x : m.points)
+      if (x.minCoeff() > 0 && x.maxCoeff() < 3) x += 0.6 * P3(rnd(), rnd(), rnd());
+    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_PRE(volume6(m, e) > 0);
+    const double vol = total_volume6(m), before = min_dihedral(m);
+    const std::size_t n_before = m.solid.size();
+    EdgeRemovalOptions eo;
+    eo.below_deg = 30.0;
+    const EdgeRemovalStats st = remove_bad_edges(m, std::vector<BoundaryLocation>(m.points.size()), nullptr, eo);
+    RC_TAG(st.removed > 0 ? "removed" : "none");
+    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_ASSERT(volume6(m, e) > 0);
+    RC_ASSERT(std::abs(total_volume6(m) - vol) <= 1e-12 * vol);
+    RC_ASSERT(min_dihedral(m) >= before - 1e-9);
+    RC_ASSERT(faces_match(m));
+    RC_ASSERT(st.removed > 0 || m.solid.size() == n_before);
+  });
+}
