@@ -16,7 +16,10 @@
 // "stale" mark), through mark(): two nodes visited at once may mark the same neighbour.
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
+#include <ctime>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -36,6 +39,38 @@ namespace febemesh {
 inline void mark(std::uint8_t& flag, std::uint8_t value) {
   std::atomic_ref<std::uint8_t>(flag).store(value, std::memory_order_relaxed);
 }
+
+/// CPU time of the calling thread, seconds.
+inline double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+/// One run of an OrderedSweep as measured when sweep_probe is set (experiments/sweep_profile).
+struct SweepRecord {
+  std::size_t nodes = 0, edges = 0;  ///< the sweep's nodes and DAG edges (0 on one thread)
+  int threads = 1;
+  std::size_t depth = 0;       ///< nodes on the DAG's longest path (critical path, unit costs)
+  double build_s = 0.0;        ///< building the DAG (once per OrderedSweep, in its first run)
+  double run_s = 0.0;          ///< the run, wall
+  double visit_s = 0.0;        ///< sum of the visits' own times
+  double critical_s = 0.0;     ///< the longest path weighted by those times
+  /// The same for whole blocks of block_sizes[k] consecutive positions (a block after every
+  /// block holding an earlier neighbour of one of its nodes; one thread per block).
+  static constexpr std::array<std::size_t, 4> block_sizes{64, 256, 1024, 4096};
+  std::array<double, 4> block_critical_s{};
+  double wait_s = 0.0;         ///< threads asleep or waiting for the lock, summed
+  double cpu_s = 0.0;          ///< the threads' CPU time in the run, summed
+  std::size_t batches = 0;     ///< lock acquisitions that took nodes
+};
+/// When set, every OrderedSweep appends one record per run (for measurements only: the DAG
+/// is then built on one thread too, and every visit is timed).
+struct SweepProbe {
+  std::mutex m;
+  std::vector<SweepRecord> runs;
+};
+inline std::atomic<SweepProbe*> sweep_probe{nullptr};
 
 /// The dependencies of an in-order sweep, by position in the sweep (see the file comment).
 struct SweepDag {
@@ -79,7 +114,11 @@ SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbo
 /// thread's share of the positions first.
 /// Waiting threads sleep. The first exception (of the lowest thread) is rethrown once all
 /// threads have stopped; nodes not yet started are then not visited.
-template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit) {
+template <class Visit>
+void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepRecord* rec = nullptr,
+               double* cost = nullptr) {
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); };
   n_threads = std::max(1, n_threads);
   const std::size_t total = dag.size();
   std::unique_ptr<std::atomic<std::int32_t>[]> waiting(new std::atomic<std::int32_t>[total]);
@@ -100,11 +139,22 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
   std::size_t done = 0;
   bool failed = false;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_threads));
+  std::vector<double> waited(static_cast<std::size_t>(n_threads), 0.0), cpu(static_cast<std::size_t>(n_threads), 0.0);
+  std::size_t n_batches = 0;
   const auto run = [&](int t) {
     std::vector<std::int32_t> mine, freed;
+    Clock::time_point t0;
+    if (rec) t0 = Clock::now(), cpu[static_cast<std::size_t>(t)] = -thread_cpu_seconds();
+    struct CpuAtExit {
+      double* slot;
+      ~CpuAtExit() {
+        if (slot) *slot += thread_cpu_seconds();
+      }
+    } cpu_at_exit{rec ? &cpu[static_cast<std::size_t>(t)] : nullptr};
     std::unique_lock lock(m);
     for (;;) {
       cv.wait(lock, [&] { return failed || done == total || n_ready > 0; });
+      if (rec) waited[static_cast<std::size_t>(t)] += seconds(t0, Clock::now()), ++n_batches;
       if (failed || done == total) return;
       // A few of the lowest ready positions of this thread's share, else of the first share
       // that has any.
@@ -121,7 +171,13 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
       freed.clear();
       try {
         for (const std::int32_t i : mine) {
-          visit(dag.node[static_cast<std::size_t>(i)], t);
+          if (cost) {
+            const auto a = Clock::now();
+            visit(dag.node[static_cast<std::size_t>(i)], t);
+            cost[i] = seconds(a, Clock::now());
+          } else {
+            visit(dag.node[static_cast<std::size_t>(i)], t);
+          }
           // acq_rel: the last earlier neighbour to finish sees the others' writes, and the
           // thread that takes the node (under the mutex) sees them all.
           for (const std::int32_t j : dag.later(static_cast<std::size_t>(i)))
@@ -134,6 +190,7 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
         cv.notify_all();
         return;
       }
+      if (rec) t0 = Clock::now();
       lock.lock();
       for (const std::int32_t j : freed) ready[share(j)].push(j);
       n_ready += freed.size();
@@ -149,8 +206,40 @@ template <class Visit> void visit_dag(const SweepDag& dag, int n_threads, const 
   for (int t = 1; t < n_threads; ++t) threads.emplace_back(run, t);
   run(0);
   for (auto& th : threads) th.join();
+  if (rec) {
+    for (const double w : waited) rec->wait_s += w;
+    for (const double c : cpu) rec->cpu_s += c;
+    rec->batches += n_batches;
+  }
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
+}
+
+/// Fills rec's depth and critical_s: the DAG's longest path by node count and by cost[i].
+inline void critical_path(const SweepDag& dag, const double* cost, SweepRecord& rec) {
+  std::vector<std::int32_t> depth(dag.size(), 1);
+  std::vector<double> time(dag.size(), 0.0);
+  for (std::size_t i = 0; i < dag.size(); ++i) {
+    time[i] += cost[i];
+    rec.depth = std::max(rec.depth, static_cast<std::size_t>(depth[i]));
+    rec.critical_s = std::max(rec.critical_s, time[i]);
+    for (const std::int32_t j : dag.later(i)) {
+      depth[static_cast<std::size_t>(j)] = std::max(depth[static_cast<std::size_t>(j)], depth[i] + 1);
+      time[static_cast<std::size_t>(j)] = std::max(time[static_cast<std::size_t>(j)], time[i]);
+    }
+  }
+  for (std::size_t k = 0; k < rec.block_sizes.size(); ++k) {
+    const std::size_t b = rec.block_sizes[k], n_blocks = (dag.size() + b - 1) / b;
+    std::vector<double> start(n_blocks, 0.0);
+    for (std::size_t blk = 0; blk < n_blocks; ++blk) {
+      double t = start[blk];
+      for (std::size_t i = blk * b; i < std::min(dag.size(), (blk + 1) * b); ++i) t += cost[i];
+      rec.block_critical_s[k] = std::max(rec.block_critical_s[k], t);
+      for (std::size_t i = blk * b; i < std::min(dag.size(), (blk + 1) * b); ++i)
+        for (const std::int32_t j : dag.later(i))
+          if (static_cast<std::size_t>(j) / b != blk) start[static_cast<std::size_t>(j) / b] = std::max(start[static_cast<std::size_t>(j) / b], t);
+    }
+  }
 }
 
 /// An in-order sweep over `nodes` (ascending), to be run once or repeatedly: on one thread (or
@@ -162,17 +251,21 @@ class OrderedSweep {
   OrderedSweep(std::vector<std::int32_t> nodes, std::size_t n, int n_threads, const Neighbours& for_neighbours,
                std::size_t min_nodes = 1024)
       : n_threads_(std::max(1, n_threads)) {
-    if (n_threads_ > 1 && nodes.size() >= min_nodes) {
+    const bool probe = sweep_probe.load(std::memory_order_relaxed) != nullptr;
+    const auto a = std::chrono::steady_clock::now();
+    if ((n_threads_ > 1 || probe) && nodes.size() >= min_nodes) {
       dag_ = sweep_dag(n, std::move(nodes), for_neighbours);
     } else {
       n_threads_ = 1;
       dag_.node = std::move(nodes);
     }
+    build_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count();
   }
   std::size_t size() const { return dag_.size(); }
   int n_threads() const { return n_threads_; }
   /// visit(v, t) for every node, t the thread (0 = the caller).
   template <class Visit> void run(const Visit& visit) const {
+    if (SweepProbe* probe = sweep_probe.load(std::memory_order_relaxed)) return run_measured(visit, *probe);
     if (n_threads_ == 1) {
       for (const std::int32_t v : dag_.node) visit(v, 0);
     } else {
@@ -181,8 +274,36 @@ class OrderedSweep {
   }
 
  private:
+  template <class Visit> void run_measured(const Visit& visit, SweepProbe& probe) const {
+    using Clock = std::chrono::steady_clock;
+    SweepRecord rec;
+    rec.nodes = dag_.size();
+    rec.edges = dag_.next.size();
+    rec.threads = n_threads_;
+    rec.build_s = std::exchange(build_s_, 0.0);
+    std::vector<double> cost(dag_.size(), 0.0);
+    const auto a = Clock::now();
+    if (n_threads_ == 1) {
+      rec.cpu_s = -thread_cpu_seconds();
+      for (std::size_t i = 0; i < dag_.node.size(); ++i) {
+        const auto b = Clock::now();
+        visit(dag_.node[i], 0);
+        cost[i] = std::chrono::duration<double>(Clock::now() - b).count();
+      }
+      rec.cpu_s += thread_cpu_seconds();
+    } else {
+      visit_dag(dag_, n_threads_, visit, &rec, cost.data());
+    }
+    rec.run_s = std::chrono::duration<double>(Clock::now() - a).count();
+    for (const double c : cost) rec.visit_s += c;
+    if (!dag_.next_start.empty()) critical_path(dag_, cost.data(), rec);
+    const std::lock_guard lock(probe.m);
+    probe.runs.push_back(rec);
+  }
+
   SweepDag dag_;
   int n_threads_ = 1;
+  mutable double build_s_ = 0.0;
 };
 
 }  // namespace febemesh
