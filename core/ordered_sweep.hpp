@@ -33,6 +33,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/parallel_ranges.hpp"
+
 namespace febemesh {
 
 /// Sets flag = value where other threads may set the same flag to the same value meanwhile.
@@ -63,6 +65,8 @@ struct SweepRecord {
   double wait_s = 0.0;         ///< threads asleep or waiting for the lock, summed
   double cpu_s = 0.0;          ///< the threads' CPU time in the run, summed
   std::size_t batches = 0;     ///< lock acquisitions that took nodes
+  std::size_t foreign = 0;     ///< visits a thread took from another thread's share
+  double foreign_s = 0.0;      ///< their summed visit times
 };
 /// When set, every OrderedSweep appends one record per run (for measurements only: the DAG
 /// is then built on one thread too, and every visit is timed).
@@ -86,34 +90,59 @@ struct SweepDag {
 
 /// The DAG of the in-order sweep over `nodes` (ascending, each < n) of a graph whose neighbours
 /// of v are listed by for_neighbours(v, f), calling f(u) for each (repeats and u = v allowed;
-/// neighbours outside the sweep are ignored). The relation must be symmetric.
+/// neighbours outside the sweep are ignored). The relation must be symmetric: a position's
+/// earlier neighbours are counted from its own list. Built on n_threads threads (for_neighbours
+/// is called from several at once), the same DAG for every count.
 template <class Neighbours>
-SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbours& for_neighbours) {
+SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbours& for_neighbours, int n_threads = 1) {
   SweepDag d;
   d.node = std::move(nodes);
+  const std::size_t m = d.node.size();
   std::vector<std::int32_t> position(n, -1);
-  for (std::size_t i = 0; i < d.node.size(); ++i) position[static_cast<std::size_t>(d.node[i])] = static_cast<std::int32_t>(i);
-  d.next_start.assign(d.node.size() + 1, 0);
-  d.n_earlier.assign(d.node.size(), 0);
-  for (std::size_t i = 0; i < d.node.size(); ++i) {
-    const std::size_t first = d.next.size();
-    for_neighbours(d.node[i], [&](std::int32_t u) {
-      const std::int32_t j = position[static_cast<std::size_t>(u)];
-      if (j > static_cast<std::int32_t>(i)) d.next.push_back(j);
-    });
-    std::sort(d.next.begin() + static_cast<std::ptrdiff_t>(first), d.next.end());
-    d.next.erase(std::unique(d.next.begin() + static_cast<std::ptrdiff_t>(first), d.next.end()), d.next.end());
-    for (std::size_t k = first; k < d.next.size(); ++k) ++d.n_earlier[static_cast<std::size_t>(d.next[k])];
-    d.next_start[i + 1] = static_cast<std::int32_t>(d.next.size());
-  }
+  for (std::size_t i = 0; i < m; ++i) position[static_cast<std::size_t>(d.node[i])] = static_cast<std::int32_t>(i);
+  d.next_start.assign(m + 1, 0);
+  d.n_earlier.assign(m, 0);
+  // Each part of the positions lists its later neighbours apart; the lists are then joined in
+  // order. A serial build was up to 0.2 s of the 2-thread smoothing stage (sphere966 L6).
+  const std::size_t n_parts = static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
+  std::vector<std::vector<std::int32_t>> part(n_parts);
+  for_each_chunk(m, std::max<std::size_t>(1, (m + n_parts - 1) / n_parts), n_threads,
+                 [&](std::size_t c, std::size_t begin, std::size_t end) {
+                   std::vector<std::int32_t> near;
+                   for (std::size_t i = begin; i < end; ++i) {
+                     near.clear();
+                     for_neighbours(d.node[i], [&](std::int32_t u) {
+                       const std::int32_t j = position[static_cast<std::size_t>(u)];
+                       if (j >= 0 && j != static_cast<std::int32_t>(i)) near.push_back(j);
+                     });
+                     std::sort(near.begin(), near.end());
+                     near.erase(std::unique(near.begin(), near.end()), near.end());
+                     const auto later = std::upper_bound(near.begin(), near.end(), static_cast<std::int32_t>(i));
+                     d.n_earlier[i] = static_cast<std::int32_t>(later - near.begin());
+                     d.next_start[i + 1] = static_cast<std::int32_t>(near.end() - later);
+                     part[c].insert(part[c].end(), later, near.end());
+                   }
+                 });
+  for (std::size_t i = 0; i < m; ++i) d.next_start[i + 1] += d.next_start[i];
+  d.next.reserve(static_cast<std::size_t>(d.next_start[m]));
+  for (const auto& p : part) d.next.insert(d.next.end(), p.begin(), p.end());
   return d;
 }
 
+/// visit_dag's shares of the positions per thread. With one share per thread a thread that ran
+/// dry took the lowest ready nodes of the other's share, where the other worked: 17% of the
+/// visits, at twice the time a visit (cache lines moving between the cores; sphere966 L6, 2
+/// threads). With 32 a thread moves to a share no other works on: 0.7% (experiments/sweep_profile
+/// --shares, runs' CPU 2.72 -> 2.31 s, medians of 3 on a loaded machine).
+inline std::size_t shares_per_thread = 32;
+
 /// Runs visit(v, t) for every node of `dag` on n_threads threads (t in [0, n_threads), 0 = the
-/// caller), each node once its earlier neighbours are done, the lowest ready position of the
-/// thread's share of the positions first.
+/// caller), each node once its earlier neighbours are done. The positions are cut into
+/// consecutive shares; a thread takes the lowest ready positions of its share, and when that
+/// has none, a share with ready nodes that no other thread works on, else it helps in another's.
 /// Waiting threads sleep. The first exception (of the lowest thread) is rethrown once all
 /// threads have stopped; nodes not yet started are then not visited.
+
 template <class Visit>
 void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepRecord* rec = nullptr,
                double* cost = nullptr) {
@@ -122,13 +151,14 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
   n_threads = std::max(1, n_threads);
   const std::size_t total = dag.size();
   std::unique_ptr<std::atomic<std::int32_t>[]> waiting(new std::atomic<std::int32_t>[total]);
-  // One heap per thread's share of the positions: a thread takes from its own first, so the
-  // threads work apart in the mesh (fewer cache lines bounce) until one runs dry and helps.
+  // One heap per share of the positions: the threads work apart in the mesh (fewer cache lines
+  // bounce) until one runs dry and helps.
   using Heap = std::priority_queue<std::int32_t, std::vector<std::int32_t>, std::greater<>>;
-  std::vector<Heap> ready(static_cast<std::size_t>(n_threads));
+  const std::size_t n_shares = std::max<std::size_t>(1, std::min(total, static_cast<std::size_t>(n_threads) * shares_per_thread));
+  std::vector<Heap> ready(n_shares);
   std::size_t n_ready = 0;
   const auto share = [&](std::int32_t i) {
-    return static_cast<std::size_t>(static_cast<std::uint64_t>(i) * static_cast<std::uint64_t>(n_threads) / total);
+    return static_cast<std::size_t>(static_cast<std::uint64_t>(i) * n_shares / total);
   };
   for (std::size_t i = 0; i < total; ++i) {
     waiting[i].store(dag.n_earlier[i], std::memory_order_relaxed);
@@ -139,8 +169,15 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
   std::size_t done = 0;
   bool failed = false;
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_threads));
-  std::vector<double> waited(static_cast<std::size_t>(n_threads), 0.0), cpu(static_cast<std::size_t>(n_threads), 0.0);
+  std::vector<double> waited(static_cast<std::size_t>(n_threads), 0.0), foreign_s(static_cast<std::size_t>(n_threads), 0.0), cpu(static_cast<std::size_t>(n_threads), 0.0);
   std::size_t n_batches = 0;
+  // Each thread starts in its own part of the positions.
+  std::vector<int> owner(n_shares, -1);
+  std::vector<std::size_t> current(static_cast<std::size_t>(n_threads));
+  for (int t = 0; t < n_threads; ++t) {
+    current[static_cast<std::size_t>(t)] = static_cast<std::size_t>(t) * n_shares / static_cast<std::size_t>(n_threads);
+    owner[current[static_cast<std::size_t>(t)]] = t;
+  }
   const auto run = [&](int t) {
     std::vector<std::int32_t> mine, freed;
     Clock::time_point t0;
@@ -156,17 +193,28 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
       cv.wait(lock, [&] { return failed || done == total || n_ready > 0; });
       if (rec) waited[static_cast<std::size_t>(t)] += seconds(t0, Clock::now()), ++n_batches;
       if (failed || done == total) return;
-      // A few of the lowest ready positions of this thread's share, else of the first share
-      // that has any.
-      std::size_t h = static_cast<std::size_t>(t);
-      if (ready[h].empty())
-        for (h = 0; ready[h].empty(); ++h) {
+      // A few of the lowest ready positions of this thread's share; else it takes the first
+      // share that has some and that no other thread works on; else it helps in the first
+      // share that has some.
+      std::size_t& h = current[static_cast<std::size_t>(t)];
+      if (ready[h].empty()) {
+        if (owner[h] == t) owner[h] = -1;
+        std::size_t s = 0;
+        while (s < n_shares && (ready[s].empty() || owner[s] >= 0)) ++s;
+        if (s < n_shares) {
+          h = s, owner[s] = t;
+        } else {
+          for (h = 0; ready[h].empty(); ++h) {
+          }
         }
+      }
       Heap& heap = ready[h];
       const std::size_t take = std::clamp<std::size_t>(heap.size() / 2, 1, 8);
       mine.clear();
       while (mine.size() < take && !heap.empty()) mine.push_back(heap.top()), heap.pop();
       n_ready -= mine.size();
+      const bool foreign = owner[h] != t;
+      if (rec && foreign) rec->foreign += mine.size();
       lock.unlock();
       freed.clear();
       try {
@@ -175,6 +223,7 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
             const auto a = Clock::now();
             visit(dag.node[static_cast<std::size_t>(i)], t);
             cost[i] = seconds(a, Clock::now());
+            if (foreign) foreign_s[static_cast<std::size_t>(t)] += cost[i];
           } else {
             visit(dag.node[static_cast<std::size_t>(i)], t);
           }
@@ -209,6 +258,7 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
   if (rec) {
     for (const double w : waited) rec->wait_s += w;
     for (const double c : cpu) rec->cpu_s += c;
+    for (const double c : foreign_s) rec->foreign_s += c;
     rec->batches += n_batches;
   }
   for (const auto& e : errors)
@@ -254,7 +304,7 @@ class OrderedSweep {
     const bool probe = sweep_probe.load(std::memory_order_relaxed) != nullptr;
     const auto a = std::chrono::steady_clock::now();
     if ((n_threads_ > 1 || probe) && nodes.size() >= min_nodes) {
-      dag_ = sweep_dag(n, std::move(nodes), for_neighbours);
+      dag_ = sweep_dag(n, std::move(nodes), for_neighbours, n_threads_);
     } else {
       n_threads_ = 1;
       dag_.node = std::move(nodes);

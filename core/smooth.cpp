@@ -53,7 +53,9 @@ Csr incident_elements(std::size_t n, const Elements& els) {
 /// instructions (callgrind). With `once`, sets once[v] = 1 for the nodes of the edges that one
 /// element uses: for triangles and quads, whose facets are their edges, the nodes of
 /// boundary_facets(els).
-Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr) {
+/// Node ranges on n_threads threads (the same lists for every count).
+Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr,
+                    int n_threads = 1) {
   Csr g;
   reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
@@ -90,51 +92,60 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
       }
     }
   };
-  std::vector<std::int32_t> seen(n, -1), uses;
-  if (once) uses.assign(n, 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto self = static_cast<std::int32_t>(v);
-    std::int32_t count = 0;
-    each_use(self, [&](std::int32_t w) {
-      if (seen[w] == self) return;
-      seen[w] = self;
-      count += w == self ? 2 : 1;  // v itself twice
-    });
-    g.start[v + 1] = g.start[v] + count;
-  }
+  // Each thread's marks: seen[w] == v while v's list is made, uses[w] counts v's uses of w.
+  const std::size_t n_workers = static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
+  for_each_chunk(n, std::max<std::size_t>(1, (n + n_workers - 1) / n_workers), n_threads,
+                 [&](std::size_t, std::size_t begin, std::size_t end) {
+                   std::vector<std::int32_t> seen(n, -1);
+                   for (std::size_t v = begin; v < end; ++v) {
+                     const auto self = static_cast<std::int32_t>(v);
+                     std::int32_t count = 0;
+                     each_use(self, [&](std::int32_t w) {
+                       if (seen[w] == self) return;
+                       seen[w] = self;
+                       count += w == self ? 2 : 1;  // v itself twice
+                     });
+                     g.start[v + 1] = count;
+                   }
+                 });
+  for (std::size_t v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
   reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
-  std::fill(seen.begin(), seen.end(), -1);
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto self = static_cast<std::int32_t>(v);
-    std::int32_t out = g.start[v];
-    bool has_self = false;
-    each_use(self, [&](std::int32_t w) {
-      if (once) ++uses[w];
-      if (seen[w] == self) return;
-      seen[w] = self;
-      has_self = has_self || w == self;
-      g.item[static_cast<std::size_t>(out++)] = w;
-    });
-    const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
-    if (hi - lo > 32) {
-      std::sort(lo, hi);
-    } else {
-      for (auto i = lo + (lo != hi); i < hi; ++i)
-        for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
-    }
-    if (once) {
-      // A value of a single use flags v (v itself: one use lists it twice).
-      for (auto i = lo; i != hi; ++i)
-        if (uses[*i] == (*i == self ? 2 : 1)) (*once)[v] = 1;
-      for (auto i = lo; i != hi; ++i) uses[*i] = 0;
-    }
-    if (has_self) {  // v itself twice, as one value per run of the sorted uses gave it
-      const auto at = std::lower_bound(lo, hi, self) + 1;
-      std::copy_backward(at, hi, hi + 1);
-      *at = self;
-    }
-  }
+  for_each_chunk(n, std::max<std::size_t>(1, (n + n_workers - 1) / n_workers), n_threads,
+                 [&](std::size_t, std::size_t begin, std::size_t end) {
+                   std::vector<std::int32_t> seen(n, -1), uses;
+                   if (once) uses.assign(n, 0);
+                   for (std::size_t v = begin; v < end; ++v) {
+                     const auto self = static_cast<std::int32_t>(v);
+                     std::int32_t out = g.start[v];
+                     bool has_self = false;
+                     each_use(self, [&](std::int32_t w) {
+                       if (once) ++uses[w];
+                       if (seen[w] == self) return;
+                       seen[w] = self;
+                       has_self = has_self || w == self;
+                       g.item[static_cast<std::size_t>(out++)] = w;
+                     });
+                     const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
+                     if (hi - lo > 32) {
+                       std::sort(lo, hi);
+                     } else {
+                       for (auto i = lo + (lo != hi); i < hi; ++i)
+                         for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+                     }
+                     if (once) {
+                       // A value of a single use flags v (v itself: one use lists it twice).
+                       for (auto i = lo; i != hi; ++i)
+                         if (uses[*i] == (*i == self ? 2 : 1)) (*once)[v] = 1;
+                       for (auto i = lo; i != hi; ++i) uses[*i] = 0;
+                     }
+                     if (has_self) {  // v itself twice, as one value per run of the sorted uses gave it
+                       const auto at = std::lower_bound(lo, hi, self) + 1;
+                       std::copy_backward(at, hi, hi + 1);
+                       *at = self;
+                     }
+                   }
+                 });
   return g;
 }
 
@@ -153,7 +164,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   });
   std::vector<std::uint8_t> on_boundary(n, 0);
   const Csr incident = incident_elements(n, mesh.solid);
-  const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr);
+  const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr, options.n_threads);
   Elements boundary;
   const bool known = options.boundary_fixed && !options.project && options.fixed.size() == n;
   if (!polygons && !known) {

@@ -41,6 +41,8 @@ int main(int argc, char** argv) {
       thread_counts.clear();
       std::stringstream ss(argv[++i]);
       for (std::string item; std::getline(ss, item, ',');) thread_counts.push_back(std::stoi(item));
+    } else if (a == "--shares" && i + 1 < argc) {
+      shares_per_thread = static_cast<std::size_t>(std::stoi(argv[++i]));
     } else if (a == "--all") {
       all = true;
     } else {
@@ -67,7 +69,7 @@ int main(int argc, char** argv) {
     for (const SweepRecord& x : probe.runs) {
       sum.nodes += x.nodes, sum.edges += x.edges, sum.depth += x.depth;
       sum.build_s += x.build_s, sum.run_s += x.run_s, sum.visit_s += x.visit_s, sum.critical_s += x.critical_s;
-      sum.wait_s += x.wait_s, sum.batches += x.batches, sum.cpu_s += x.cpu_s;
+      sum.wait_s += x.wait_s, sum.batches += x.batches, sum.cpu_s += x.cpu_s, sum.foreign += x.foreign, sum.foreign_s += x.foreign_s;
       for (std::size_t k = 0; k < x.block_sizes.size(); ++k) sum.block_critical_s[k] += x.block_critical_s[k];
       max_depth = std::max(max_depth, x.depth);
       if (all)
@@ -77,10 +79,12 @@ int main(int argc, char** argv) {
     }
     std::printf("threads %d: smoothing stage %.3f s; %zu sweep runs, %zu visits, %zu DAG edges; depth sum %zu "
                 "(max %zu); DAG builds %.3f s; runs %.3f s wall; visits %.3f s; critical %.4f s "
-                "(visits / critical %.0f); runs' CPU %.3f s; waiting %.3f s; %zu batches (%.1f visits each)\n",
+                "(visits / critical %.0f); runs' CPU %.3f s; waiting %.3f s; %zu batches (%.1f visits each), %zu visits from another thread's share (%.3f s, %.2f us each; the rest %.2f us each)\n",
                 threads, smoothing, probe.runs.size(), sum.nodes, sum.edges, sum.depth, max_depth, sum.build_s,
                 sum.run_s, sum.visit_s, sum.critical_s, sum.critical_s > 0 ? sum.visit_s / sum.critical_s : 0.0,
-                sum.cpu_s, sum.wait_s, sum.batches, sum.batches > 0 ? double(sum.nodes) / double(sum.batches) : 0.0);
+                sum.cpu_s, sum.wait_s, sum.batches, sum.batches > 0 ? double(sum.nodes) / double(sum.batches) : 0.0, sum.foreign, sum.foreign_s,
+                sum.foreign > 0 ? 1e6 * sum.foreign_s / double(sum.foreign) : 0.0,
+                1e6 * (sum.visit_s - sum.foreign_s) / double(std::max<std::size_t>(1, sum.nodes - sum.foreign)));
     for (std::size_t k = 0; k < sum.block_sizes.size(); ++k)
       std::printf("  blocks of %zu positions: critical %.4f s (visits / critical %.1f)\n", sum.block_sizes[k],
                   sum.block_critical_s[k], sum.block_critical_s[k] > 0 ? sum.visit_s / sum.block_critical_s[k] : 0.0);
