@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
 #include "core/huge_pages.hpp"
+#include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
@@ -28,19 +29,15 @@ struct Csr {
 };
 
 /// Node -> the elements that use it, in increasing order (once per use).
-Csr incident_elements(std::size_t n, const Elements& els) {
+Csr incident_elements(std::size_t n, const Elements& els, int n_threads = 1) {
   Csr g;
-  reserve_huge(g.start, n + 1);
-  g.start.assign(n + 1, 0);
-  for (const VertexId v : els.node) ++g.start[v.v + 1];
-  for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
-  reserve_huge(g.item, std::size_t(g.start[n]));
-  g.item.resize(g.start[n]);
-  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
-  for (std::size_t e = 0; e < els.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int i = 0; i < els.n_nodes_of(id); ++i) g.item[fill[els.nodes(id)[i].v]++] = id.v;
-  }
+  incidence_csr(
+      n, els.size(),
+      [&](std::size_t e, auto&& f) {
+        const ElemId id{static_cast<std::int32_t>(e)};
+        for (int i = 0; i < els.n_nodes_of(id); ++i) f(els.nodes(id)[i].v);
+      },
+      n_threads, g.start, g.item);
   return g;
 }
 
@@ -93,9 +90,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     }
   };
   // Each thread's marks: seen[w] == v while v's list is made, uses[w] counts v's uses of w.
-  const std::size_t n_workers = static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
-  for_each_chunk(n, std::max<std::size_t>(1, (n + n_workers - 1) / n_workers), n_threads,
-                 [&](std::size_t, std::size_t begin, std::size_t end) {
+  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
                    std::vector<std::int32_t> seen(n, -1);
                    for (std::size_t v = begin; v < end; ++v) {
                      const auto self = static_cast<std::int32_t>(v);
@@ -111,8 +106,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
   for (std::size_t v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
   reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
-  for_each_chunk(n, std::max<std::size_t>(1, (n + n_workers - 1) / n_workers), n_threads,
-                 [&](std::size_t, std::size_t begin, std::size_t end) {
+  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
                    std::vector<std::int32_t> seen(n, -1), uses;
                    if (once) uses.assign(n, 0);
                    for (std::size_t v = begin; v < end; ++v) {
@@ -163,7 +157,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     return t == ElemType::Tri3 || t == ElemType::Quad4;
   });
   std::vector<std::uint8_t> on_boundary(n, 0);
-  const Csr incident = incident_elements(n, mesh.solid);
+  const Csr incident = incident_elements(n, mesh.solid, options.n_threads);
   const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr, options.n_threads);
   Elements boundary;
   const bool known = options.boundary_fixed && !options.project && options.fixed.size() == n;

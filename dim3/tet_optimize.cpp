@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "core/error.hpp"
+#include "core/incidence_csr.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
 #include "dim3/moving_tet.hpp"
@@ -324,9 +325,7 @@ struct Optimizer {
         for (std::int32_t u : tets[incident[k]])
           if (u != self && seen[u] != self) seen[u] = self, visit(u);
     };
-    const std::size_t n_workers = static_cast<std::size_t>(std::clamp(opt.n_threads, 1, 256));
-    const std::size_t chunk = std::max<std::size_t>(1, (n + n_workers - 1) / n_workers);
-    for_each_chunk(n, chunk, opt.n_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for_each_range(n, opt.n_threads, [&](std::size_t begin, std::size_t end) {
       std::vector<std::int32_t> seen(n, -1);
       for (std::size_t v = begin; v < end; ++v) {
         std::int32_t count = 0;
@@ -336,7 +335,7 @@ struct Optimizer {
     });
     for (std::size_t v = 0; v < n; ++v) nb_start[v + 1] += nb_start[v];
     nbs.resize(static_cast<std::size_t>(nb_start[n]));
-    for_each_chunk(n, chunk, opt.n_threads, [&](std::size_t, std::size_t begin, std::size_t end) {
+    for_each_range(n, opt.n_threads, [&](std::size_t begin, std::size_t end) {
       std::vector<std::int32_t> seen(n, -1);
       for (std::size_t v = begin; v < end; ++v) {
         std::int32_t out = nb_start[v];
@@ -571,16 +570,12 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     MESH_ASSERT(mesh.solid.offset[e] == static_cast<std::int32_t>(4 * e), "element " << e << " is not at 4 e");
   }
   o.tets = {mesh.solid.node.data(), mesh.solid.size()};  // the connectivity does not change here
-  o.start.assign(n + 1, 0);
-  for (std::size_t t = 0; t < o.tets.size(); ++t)
-    for (std::int32_t v : o.tets[t]) ++o.start[v + 1];
-  for (std::size_t v = 0; v < n; ++v) o.start[v + 1] += o.start[v];
-  o.incident.resize(o.start[n]);
-  {
-    std::vector<std::int32_t> fill(o.start.begin(), o.start.end() - 1);
-    for (std::size_t t = 0; t < o.tets.size(); ++t)
-      for (std::int32_t v : o.tets[t]) o.incident[fill[v]++] = static_cast<std::int32_t>(t);
-  }
+  incidence_csr(
+      n, o.tets.size(),
+      [&](std::size_t t, auto&& f) {
+        for (std::int32_t v : o.tets[t]) f(v);
+      },
+      opt.n_threads, o.start, o.incident);
   if (opt.surface_normal && opt.project) {
     o.node_normal.assign(n, P3::Zero());
     for (std::size_t v = 0; v < n && v < where.size(); ++v)
