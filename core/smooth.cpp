@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
 #include "core/huge_pages.hpp"
+#include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
@@ -28,19 +29,15 @@ struct Csr {
 };
 
 /// Node -> the elements that use it, in increasing order (once per use).
-Csr incident_elements(std::size_t n, const Elements& els) {
+Csr incident_elements(std::size_t n, const Elements& els, int n_threads = 1) {
   Csr g;
-  reserve_huge(g.start, n + 1);
-  g.start.assign(n + 1, 0);
-  for (const VertexId v : els.node) ++g.start[v.v + 1];
-  for (std::size_t i = 0; i < n; ++i) g.start[i + 1] += g.start[i];
-  reserve_huge(g.item, std::size_t(g.start[n]));
-  g.item.resize(g.start[n]);
-  std::vector<std::int32_t> fill(g.start.begin(), g.start.end() - 1);
-  for (std::size_t e = 0; e < els.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int i = 0; i < els.n_nodes_of(id); ++i) g.item[fill[els.nodes(id)[i].v]++] = id.v;
-  }
+  incidence_csr(
+      n, els.size(),
+      [&](std::size_t e, auto&& f) {
+        const ElemId id{static_cast<std::int32_t>(e)};
+        for (int i = 0; i < els.n_nodes_of(id); ++i) f(els.nodes(id)[i].v);
+      },
+      n_threads, g.start, g.item);
   return g;
 }
 
@@ -53,7 +50,9 @@ Csr incident_elements(std::size_t n, const Elements& els) {
 /// instructions (callgrind). With `once`, sets once[v] = 1 for the nodes of the edges that one
 /// element uses: for triangles and quads, whose facets are their edges, the nodes of
 /// boundary_facets(els).
-Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr) {
+/// Node ranges on n_threads threads (the same lists for every count).
+Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr,
+                    int n_threads = 1) {
   Csr g;
   reserve_huge(g.start, n + 1);
   g.start.assign(n + 1, 0);
@@ -90,51 +89,57 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
       }
     }
   };
-  std::vector<std::int32_t> seen(n, -1), uses;
-  if (once) uses.assign(n, 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto self = static_cast<std::int32_t>(v);
-    std::int32_t count = 0;
-    each_use(self, [&](std::int32_t w) {
-      if (seen[w] == self) return;
-      seen[w] = self;
-      count += w == self ? 2 : 1;  // v itself twice
-    });
-    g.start[v + 1] = g.start[v] + count;
-  }
+  // Each thread's marks: seen[w] == v while v's list is made, uses[w] counts v's uses of w.
+  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
+                   std::vector<std::int32_t> seen(n, -1);
+                   for (std::size_t v = begin; v < end; ++v) {
+                     const auto self = static_cast<std::int32_t>(v);
+                     std::int32_t count = 0;
+                     each_use(self, [&](std::int32_t w) {
+                       if (seen[w] == self) return;
+                       seen[w] = self;
+                       count += w == self ? 2 : 1;  // v itself twice
+                     });
+                     g.start[v + 1] = count;
+                   }
+                 });
+  for (std::size_t v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
   reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
-  std::fill(seen.begin(), seen.end(), -1);
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto self = static_cast<std::int32_t>(v);
-    std::int32_t out = g.start[v];
-    bool has_self = false;
-    each_use(self, [&](std::int32_t w) {
-      if (once) ++uses[w];
-      if (seen[w] == self) return;
-      seen[w] = self;
-      has_self = has_self || w == self;
-      g.item[static_cast<std::size_t>(out++)] = w;
-    });
-    const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
-    if (hi - lo > 32) {
-      std::sort(lo, hi);
-    } else {
-      for (auto i = lo + (lo != hi); i < hi; ++i)
-        for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
-    }
-    if (once) {
-      // A value of a single use flags v (v itself: one use lists it twice).
-      for (auto i = lo; i != hi; ++i)
-        if (uses[*i] == (*i == self ? 2 : 1)) (*once)[v] = 1;
-      for (auto i = lo; i != hi; ++i) uses[*i] = 0;
-    }
-    if (has_self) {  // v itself twice, as one value per run of the sorted uses gave it
-      const auto at = std::lower_bound(lo, hi, self) + 1;
-      std::copy_backward(at, hi, hi + 1);
-      *at = self;
-    }
-  }
+  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
+                   std::vector<std::int32_t> seen(n, -1), uses;
+                   if (once) uses.assign(n, 0);
+                   for (std::size_t v = begin; v < end; ++v) {
+                     const auto self = static_cast<std::int32_t>(v);
+                     std::int32_t out = g.start[v];
+                     bool has_self = false;
+                     each_use(self, [&](std::int32_t w) {
+                       if (once) ++uses[w];
+                       if (seen[w] == self) return;
+                       seen[w] = self;
+                       has_self = has_self || w == self;
+                       g.item[static_cast<std::size_t>(out++)] = w;
+                     });
+                     const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
+                     if (hi - lo > 32) {
+                       std::sort(lo, hi);
+                     } else {
+                       for (auto i = lo + (lo != hi); i < hi; ++i)
+                         for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+                     }
+                     if (once) {
+                       // A value of a single use flags v (v itself: one use lists it twice).
+                       for (auto i = lo; i != hi; ++i)
+                         if (uses[*i] == (*i == self ? 2 : 1)) (*once)[v] = 1;
+                       for (auto i = lo; i != hi; ++i) uses[*i] = 0;
+                     }
+                     if (has_self) {  // v itself twice, as one value per run of the sorted uses gave it
+                       const auto at = std::lower_bound(lo, hi, self) + 1;
+                       std::copy_backward(at, hi, hi + 1);
+                       *at = self;
+                     }
+                   }
+                 });
   return g;
 }
 
@@ -152,8 +157,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     return t == ElemType::Tri3 || t == ElemType::Quad4;
   });
   std::vector<std::uint8_t> on_boundary(n, 0);
-  const Csr incident = incident_elements(n, mesh.solid);
-  const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr);
+  const Csr incident = incident_elements(n, mesh.solid, options.n_threads);
+  const Csr neighbours = edge_neighbours(n, mesh.solid, incident, polygons ? &on_boundary : nullptr, options.n_threads);
   Elements boundary;
   const bool known = options.boundary_fixed && !options.project && options.fixed.size() == n;
   if (!polygons && !known) {

@@ -12,6 +12,7 @@
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
 #include "core/validate.hpp"
@@ -78,17 +79,23 @@ std::string describe(const std::vector<Problem3>& problems) {
   return os.str();
 }
 
-/// Solid elements that are inverted or flat (signed volume below 1e-12 of their edge cubed).
-std::vector<std::size_t> inverted_elements(const Mesh<3>& m) {
+/// Solid elements that are inverted or flat (signed volume below 1e-12 of their edge cubed),
+/// ascending; marked on n_threads threads.
+std::vector<std::size_t> inverted_elements(const Mesh<3>& m, int n_threads = 1) {
+  std::vector<std::uint8_t> flat(m.solid.size(), 0);
+  for_each_range(m.solid.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) {
+      const ElemId id{static_cast<std::int32_t>(e)};
+      const auto pts = element_points<3>(m.solid, id, m.points);
+      double len = 0.0;
+      for (int a = 0; a < pts.n; ++a)
+        for (int b = a + 1; b < pts.n; ++b) len = std::max(len, (pts.p[a] - pts.p[b]).norm());
+      flat[e] = signed_measure<3>(m.solid.type[e], pts.span()) <= 1e-12 * len * len * len ? 1 : 0;
+    }
+  });
   std::vector<std::size_t> out;
-  for (std::size_t e = 0; e < m.solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    const auto pts = element_points<3>(m.solid, id, m.points);
-    double len = 0.0;
-    for (int a = 0; a < pts.n; ++a)
-      for (int b = a + 1; b < pts.n; ++b) len = std::max(len, (pts.p[a] - pts.p[b]).norm());
-    if (signed_measure<3>(m.solid.type[e], pts.span()) <= 1e-12 * len * len * len) out.push_back(e);
-  }
+  for (std::size_t e = 0; e < flat.size(); ++e)
+    if (flat[e]) out.push_back(e);
   return out;
 }
 
@@ -783,7 +790,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           r.n_untangle_moves += ts.moves;
           say(untangle_summary("untangling", ts));
         }
-        const std::vector<std::size_t> bad = inverted_elements(fe.mesh);
+        const std::vector<std::size_t> bad = inverted_elements(fe.mesh, opt.n_threads);
         const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s);
         std::set<std::int32_t> revert;
         const auto revert_snapped = [&](const Elements& elems, std::size_t e) {
@@ -811,7 +818,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
                   untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal, opt.n_threads);
               r.n_untangle_moves += ts.moves;
               say(untangle_summary("untangling (Escobar objective)", ts));
-              bad2 = inverted_elements(fe.mesh);
+              bad2 = inverted_elements(fe.mesh, opt.n_threads);
               folded2 = folded_faces(fe.mesh, fe.where, s);
               if (bad2.empty() && folded2.empty()) before_escobar = std::move(old_problems);
             }
@@ -900,7 +907,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         }
       }
       clock.lap("smoothing");
-      add_problems(fe.mesh, inverted_elements(fe.mesh), folds_pending ? std::vector<std::size_t>{} : folded_faces(fe.mesh, fe.where, s),
+      add_problems(fe.mesh, inverted_elements(fe.mesh, opt.n_threads), folds_pending ? std::vector<std::size_t>{} : folded_faces(fe.mesh, fe.where, s),
                    " after smoothing", problems);
       if (problems.empty() && folds_pending) {
         // Folded interface triangles where the surface's normals at their nodes disagree (the

@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "core/error.hpp"
+#include "core/incidence_csr.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
 #include "dim3/moving_tet.hpp"
@@ -317,31 +318,37 @@ struct Optimizer {
     // L5, of which the sort most).
     // Two passes, counting then filling: the array has its exact size (push_back's growth left
     // up to twice, at the optimiser's heap peak).
-    std::vector<std::int32_t> seen(n, -1);
-    const auto for_distinct = [&](std::size_t v, auto&& visit) {
+    // Node ranges on opt.n_threads threads, each with its own marks (the same lists).
+    const auto for_distinct = [&](std::vector<std::int32_t>& seen, std::size_t v, auto&& visit) {
       const auto self = static_cast<std::int32_t>(v);
       for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
         for (std::int32_t u : tets[incident[k]])
           if (u != self && seen[u] != self) seen[u] = self, visit(u);
     };
-    for (std::size_t v = 0; v < n; ++v) {
-      std::int32_t count = 0;
-      for_distinct(v, [&](std::int32_t) { ++count; });
-      nb_start[v + 1] = nb_start[v] + count;
-    }
-    nbs.resize(static_cast<std::size_t>(nb_start[n]));
-    std::fill(seen.begin(), seen.end(), -1);
-    for (std::size_t v = 0; v < n; ++v) {
-      std::int32_t out = nb_start[v];
-      for_distinct(v, [&](std::int32_t u) { nbs[out++] = u; });
-      const auto lo = nbs.begin() + nb_start[v], hi = nbs.begin() + out;
-      if (hi - lo > 32) {
-        std::sort(lo, hi);
-      } else {
-        for (auto i = lo + (lo != hi); i < hi; ++i)
-          for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+    for_each_range(n, opt.n_threads, [&](std::size_t begin, std::size_t end) {
+      std::vector<std::int32_t> seen(n, -1);
+      for (std::size_t v = begin; v < end; ++v) {
+        std::int32_t count = 0;
+        for_distinct(seen, v, [&](std::int32_t) { ++count; });
+        nb_start[v + 1] = count;
       }
-    }
+    });
+    for (std::size_t v = 0; v < n; ++v) nb_start[v + 1] += nb_start[v];
+    nbs.resize(static_cast<std::size_t>(nb_start[n]));
+    for_each_range(n, opt.n_threads, [&](std::size_t begin, std::size_t end) {
+      std::vector<std::int32_t> seen(n, -1);
+      for (std::size_t v = begin; v < end; ++v) {
+        std::int32_t out = nb_start[v];
+        for_distinct(seen, v, [&](std::int32_t u) { nbs[out++] = u; });
+        const auto lo = nbs.begin() + nb_start[v], hi = nbs.begin() + out;
+        if (hi - lo > 32) {
+          std::sort(lo, hi);
+        } else {
+          for (auto i = lo + (lo != hi); i < hi; ++i)
+            for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
+        }
+      }
+    });
   }
   bool is_surface(std::int32_t v) const {
     return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0;
@@ -563,16 +570,12 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     MESH_ASSERT(mesh.solid.offset[e] == static_cast<std::int32_t>(4 * e), "element " << e << " is not at 4 e");
   }
   o.tets = {mesh.solid.node.data(), mesh.solid.size()};  // the connectivity does not change here
-  o.start.assign(n + 1, 0);
-  for (std::size_t t = 0; t < o.tets.size(); ++t)
-    for (std::int32_t v : o.tets[t]) ++o.start[v + 1];
-  for (std::size_t v = 0; v < n; ++v) o.start[v + 1] += o.start[v];
-  o.incident.resize(o.start[n]);
-  {
-    std::vector<std::int32_t> fill(o.start.begin(), o.start.end() - 1);
-    for (std::size_t t = 0; t < o.tets.size(); ++t)
-      for (std::int32_t v : o.tets[t]) o.incident[fill[v]++] = static_cast<std::int32_t>(t);
-  }
+  incidence_csr(
+      n, o.tets.size(),
+      [&](std::size_t t, auto&& f) {
+        for (std::int32_t v : o.tets[t]) f(v);
+      },
+      opt.n_threads, o.start, o.incident);
   if (opt.surface_normal && opt.project) {
     o.node_normal.assign(n, P3::Zero());
     for (std::size_t v = 0; v < n && v < where.size(); ++v)
@@ -618,21 +621,21 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   o.tet_q.resize(o.tets.size());
   o.target_rank = angle_rank(target);
   o.tangent_rank = angle_rank(opt.tangent_below_deg * pi / 180.0);
-  bool any_active = false;
+  std::atomic<bool> some_active{false};
   for_each_range(o.tets.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+    bool here = false;
     for (std::size_t i = begin; i < end; ++i) {
       const Tet& t = o.tets[i];
-      o.tet_q[i] = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+      const double q = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+      o.tet_q[i] = q;
+      if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
+        here = true;
+        for (std::int32_t v : t) mark(active[v], 1);  // another range may mark the same node
+      }
     }
+    if (here) some_active.store(true, std::memory_order_relaxed);
   });
-  for (std::size_t i = 0; i < o.tets.size(); ++i) {
-    const Tet& t = o.tets[i];
-    const double q = o.tet_q[i];
-    if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
-      any_active = true;
-      for (std::int32_t v : t) active[v] = 1;
-    }
-  }
+  bool any_active = some_active.load();
   measure(st.inverted_before, st.min_dihedral_before_deg);
   st.folded_before = count_folded();
   if (st.folded_before > 0) {

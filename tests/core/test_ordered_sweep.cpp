@@ -141,6 +141,8 @@ TEST_CASE("sweep_dag links each node to its neighbours in the sweep", "[ordered_
     const Graph g = random_graph(n, seed, links);
     const std::vector<std::int32_t> nodes = some_nodes(n);
     check_dag(g, nodes, sweep_dag(n, nodes, g.neighbours()));
+    const int threads = *rc::gen::inRange(2, 5);
+    check_dag(g, nodes, sweep_dag(n, nodes, g.neighbours(), threads));  // built in parts
   });
 }
 
