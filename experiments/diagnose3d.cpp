@@ -22,6 +22,10 @@
 // --unfold turns on BoundaryOctantOptions::unfold_backward (here and with --pipeline). The
 // counts also give the face nodes with free faces on both sides of an axis (no single
 // projection leaves through both) and the folded octants with such a node.
+// --single (with --pipeline): one try, without the fallbacks (no buffer, no feature snapping,
+// facing projections, level raise, thickness retry); --nosnap: no feature snapping there;
+// --feature-extra L: SurfaceOptions::feature_extra_levels (default 1), the level field's
+// feature level above the global one; --near X Y Z R with --dump: only octants near a point.
 
 #include <cmath>
 #include <cstdio>
