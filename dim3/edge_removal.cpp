@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/incidence_csr.hpp"
 #include "dim3/tet_optimize.hpp"
 
 namespace febemesh::dim3 {
@@ -254,16 +255,12 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   const double below = opt.below_deg * pi / 180.0;
   if (std::none_of(w.q.begin(), w.q.end(), [&](double q) { return q < below; })) return {};
   w.alive.assign(w.tets.size(), 1);
-  w.at_start.assign(n + 1, 0);
-  for (const Tet& t : w.tets)
-    for (const std::int32_t u : t) ++w.at_start[static_cast<std::size_t>(u) + 1];
-  for (std::size_t i = 0; i < n; ++i) w.at_start[i + 1] += w.at_start[i];
-  w.at_list.resize(static_cast<std::size_t>(w.at_start[n]));
-  {
-    std::vector<std::int32_t> fill(w.at_start.begin(), w.at_start.end() - 1);
-    for (std::size_t e = 0; e < w.tets.size(); ++e)
-      for (const std::int32_t u : w.tets[e]) w.at_list[static_cast<std::size_t>(fill[u]++)] = static_cast<std::int32_t>(e);
-  }
+  incidence_csr(
+      n, w.tets.size(),
+      [&](std::size_t e, auto&& f) {
+        for (const std::int32_t u : w.tets[e]) f(u);
+      },
+      1, w.at_start, w.at_list);
   w.at_added.resize(n);
   for (std::size_t f = 0; f < mesh.interface.size(); ++f) {
     MESH_ASSERT(mesh.interface.type[f] == ElemType::Tri3, "remove_bad_edges needs interface triangles");
