@@ -304,6 +304,12 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
     if (!w.from_boundary.empty()) from_boundary.push_back(w.from_boundary[t]);
     if (!w.cell.empty()) cells.push_back(w.cell[t]);
   }
+  if (cell && !w.cell.empty()) {
+    for (std::size_t t = 0; t < w.alive.size(); ++t)
+      if (!w.alive[t]) st.cells_changed.push_back(w.cell[t]);
+    std::sort(st.cells_changed.begin(), st.cells_changed.end());
+    st.cells_changed.erase(std::unique(st.cells_changed.begin(), st.cells_changed.end()), st.cells_changed.end());
+  }
   Elements interface;
   for (std::size_t f = 0; f < w.faces.size(); ++f)
     if (w.face_alive[f]) interface.add(ElemType::Tri3, {VertexId{w.faces[f][0]}, VertexId{w.faces[f][1]}, VertexId{w.faces[f][2]}});

@@ -40,6 +40,9 @@ struct EdgeRemovalOptions {
 struct EdgeRemovalStats {
   std::size_t removed = 0;          ///< edges removed
   std::size_t surface_swapped = 0;  ///< of them, surface edges
+  /// With `cell`: the cells (ascending, each once) that lost a tetrahedron, so whose
+  /// tetrahedra are no longer their template's (make_hex_dominant leaves them as they are).
+  std::vector<std::int32_t> cells_changed;
 };
 
 /// Removes edges of bad tetrahedra from `mesh` (all Tet4; interface all Tri3, outward) while a

@@ -76,6 +76,9 @@ struct CellInfo {
   bool candidate = false;  // all six faces plain quads
   Ring4 lower{}, upper{};  // hex in Gmsh order: lower face, then the nodes above each
   bool is_hex = false;
+  /// Its tetrahedra are not the template's cones (TetMesh::cells_changed): it sees no quad, so
+  /// the quads it shares with other cells are split, and its tetrahedra stay as they are.
+  bool changed = false;
 };
 
 struct Faces {
@@ -145,10 +148,12 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   MESH_ASSERT(fe.cell.size() == m.solid.size(), "cell per element");
   const std::size_t n_interior = oc.interior.size();
   std::vector<CellInfo> cells(n_interior + oc.boundary.size());
+  for (const std::int32_t c : fe.cells_changed) cells[c].changed = true;
   for (std::size_t e = 0; e < m.solid.size(); ++e) {
     MESH_ASSERT(m.solid.type[e] == ElemType::Tet4, "make_hex_dominant takes the template tets");
     CellInfo& ci = cells[fe.cell[e]];
     ci.cones.push_back(e);
+    if (ci.changed) continue;
     const std::int32_t apex = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)})[3].v;
     MESH_ASSERT(ci.apex < 0 || ci.apex == apex, "cones of one cell share the centroid");
     ci.apex = apex;
@@ -157,7 +162,7 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   Faces faces;
   for (std::size_t k = 0; k < n_interior; ++k) {
     CellInfo& ci = cells[k];
-    if (ci.cones.empty()) continue;
+    if (ci.cones.empty() || ci.changed) continue;
     const Cell<3>& c = t.leaf(oc.interior[k]);
     int n_plain = 0;
     std::vector<Ring4> quads;
@@ -182,7 +187,7 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   }
   for (std::size_t k = 0; k < oc.boundary.size(); ++k) {
     CellInfo& ci = cells[n_interior + k];
-    if (ci.cones.empty()) continue;
+    if (ci.cones.empty() || ci.changed) continue;
     const BoundaryOctant& bo = oc.boundary[k];
     const std::size_t n = bo.ring.size();
     std::vector<std::int32_t> p(n);

@@ -1,6 +1,7 @@
 #include "dim3/pipeline3d.hpp"
 
 #include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -886,7 +887,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
           }
         }
-        if (opt.remove_edges_below_deg > 0 && !opt.hex_dominant) {
+        if (opt.remove_edges_below_deg > 0) {
           // Node moves stall where the connectivity fixes a wedge (anchor L5: four tetrahedra
           // around a surface edge whose triangles meet at 62 deg, five under 10 deg). Measured
           // (CLI, min dihedral deg, base -> edges under 15 deg -> under 30): anchor L5 9.45 ->
@@ -897,10 +898,19 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           // with a sort per removal instead of a heap: anchor L5 14.3 s instead of 6.5).
           EdgeRemovalOptions eo;
           eo.below_deg = opt.remove_edges_below_deg;
+          // A hex-dominant mesh loses every hex and pyramid of a cell whose tetrahedra change:
+          // there only the tetrahedra under the merge's own bar (sphere966 L4 at 30 deg: hex
+          // volume share 0.999 -> 0.459).
+          if (opt.hex_dominant) eo.below_deg = std::min(eo.below_deg, opt.hex.min_dihedral_deg);
           eo.surface_normal = surface_normal;
           for (int round = 0; round < 3; ++round) {
             const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
             r.n_edges_removed += es.removed;
+            // With --elements hex those cells stay tetrahedra (make_hex_dominant).
+            std::vector<std::int32_t> changed;
+            std::set_union(fe.cells_changed.begin(), fe.cells_changed.end(), es.cells_changed.begin(),
+                           es.cells_changed.end(), std::back_inserter(changed));
+            fe.cells_changed = std::move(changed);
             if (es.removed == 0) break;
             r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
           }

@@ -71,8 +71,8 @@ struct Options3d {
   bool slide_feature_nodes = true;
   /// After those sweeps, edges of tetrahedra under this angle (degrees) are removed where
   /// that raises the worst angle around them (dim3/edge_removal.hpp), then one more sweep
-  /// pass; up to three rounds while edges go. 0 = none. Not with hex_dominant (it merges the
-  /// templates' tetrahedra).
+  /// pass; up to three rounds while edges go. 0 = none. With hex_dominant the cells whose
+  /// tetrahedra it changed stay tetrahedra (TetMesh::cells_changed).
   double remove_edges_below_deg = 30.0;  // the sweeps' target_dihedral_deg
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Repairs that may leave more problems than the tree before them: a try stops at the next

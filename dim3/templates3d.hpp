@@ -38,6 +38,9 @@ struct TetMesh {
   /// Per solid element: the cell it came from (index into complex.interior, then
   /// complex.boundary offset by complex.interior.size()).
   std::vector<std::int32_t> cell;
+  /// Cells (ascending, each once) whose tetrahedra are no longer the template's cones: edge
+  /// removal (dim3/edge_removal.hpp) replaced some of them. make_hex_dominant keeps them tets.
+  std::vector<std::int32_t> cells_changed;
   std::size_t n_dropped_degenerate = 0;  ///< cones with a repeated node (degenerate octants)
   std::size_t n_fins_cancelled = 0;      ///< pairs of back-to-back triangles of one cell, dropped
 };
