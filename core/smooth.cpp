@@ -15,6 +15,7 @@
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/quality.hpp"
+#include "core/sort_short.hpp"
 
 namespace febemesh {
 
@@ -121,12 +122,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
                        g.item[static_cast<std::size_t>(out++)] = w;
                      });
                      const auto lo = g.item.begin() + g.start[v], hi = g.item.begin() + out;
-                     if (hi - lo > 32) {
-                       std::sort(lo, hi);
-                     } else {
-                       for (auto i = lo + (lo != hi); i < hi; ++i)
-                         for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
-                     }
+                     sort_short(lo, hi);
                      if (once) {
                        // A value of a single use flags v (v itself: one use lists it twice).
                        for (auto i = lo; i != hi; ++i)

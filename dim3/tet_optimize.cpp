@@ -12,6 +12,7 @@
 #include "core/incidence_csr.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/sort_short.hpp"
 #include "dim3/moving_tet.hpp"
 
 namespace febemesh::dim3 {
@@ -341,12 +342,7 @@ struct Optimizer {
         std::int32_t out = nb_start[v];
         for_distinct(seen, v, [&](std::int32_t u) { nbs[out++] = u; });
         const auto lo = nbs.begin() + nb_start[v], hi = nbs.begin() + out;
-        if (hi - lo > 32) {
-          std::sort(lo, hi);
-        } else {
-          for (auto i = lo + (lo != hi); i < hi; ++i)
-            for (auto j = i; j != lo && *j < *(j - 1); --j) std::iter_swap(j, j - 1);
-        }
+        sort_short(lo, hi);
       }
     });
   }
