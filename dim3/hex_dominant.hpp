@@ -21,7 +21,9 @@
 //   below both min_dihedral_deg and their cones' (a hex likewise against its cones; warped
 //   quads), or when it is not seen as a quad by both cells; a hex with a split face
 //   becomes pyramids. Repeated until nothing changes (splits only grow), so every
-//   shared face is the same quad or the same two triangles on both sides.
+//   shared face is the same quad or the same two triangles on both sides;
+// - a cell whose tetrahedra edge removal replaced (TetMesh::cells_changed: they are no longer
+//   its cones) keeps them as they are and sees no quad, so every quad it shares is split.
 
 #include <cstddef>
 
