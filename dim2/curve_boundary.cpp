@@ -281,9 +281,22 @@ ClosestPoint<2> CurveBoundary::make_result(int rec, double u, const P2& p) const
   const Loop& loop = domain_.loops[std::size_t(pc.loop)];
   const std::size_t n = loop.n_pieces();
   std::size_t piece = std::size_t(pc.index);
+  // Within round-off of a corner is the corner. Newton's minimum can end just short of a
+  // piece's end, which then is not reported as the corner; where the curve is stationary at the
+  // corner (a repeated control point) u = 1 - 2.6e-9 was 3e-28 from it, and a node the quality
+  // pass slid there sat on the corner's node (a random domain of the property suite: quad, 2
+  // smoothing iterations, a hole's tip at (0.19, 0)). So: within 1e-12 of the bounding box's
+  // diagonal (the validator's duplicate-node distance) of a corner, the corner.
+  const std::size_t next = (piece + 1) % n;
+  if (u > 0.0 && u < 1.0) {
+    const double tol = 1e-12 * bbox_.extent().norm();
+    const P2 at_u = bezier_point(pc.q, u);
+    if (corner_of_[std::size_t(pc.loop)][piece] >= 0 && (at_u - bezier_point(pc.q, 0.0)).norm() <= tol) u = 0.0;
+    else if (corner_of_[std::size_t(pc.loop)][next] >= 0 && (at_u - bezier_point(pc.q, 1.0)).norm() <= tol) u = 1.0;
+  }
   const P2 point = bezier_point(pc.q, u);
   if (u >= 1.0) {
-    piece = (piece + 1) % n;
+    piece = next;
     u = 0.0;
   }
   ClosestPoint<2> r;
