@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/incidence_csr.hpp"
+#include "core/parallel_ranges.hpp"
 #include "dim3/tet_optimize.hpp"
 
 namespace febemesh::dim3 {
@@ -262,9 +263,16 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   // Worst first; new tetrahedra below the bar join the list (each removal raises the worst
   // angle around its edge, so this ends; the cap is a guard).
   using Entry = std::pair<double, std::int32_t>;  // (quality, tetrahedron): the worst on top
+  // The scan in fixed chunks whose lists join in chunk order: the same list on any threads.
+  constexpr std::size_t chunk = 1 << 16;
+  std::vector<std::vector<Entry>> bad_in((static_cast<std::size_t>(w.n_input) + chunk - 1) / chunk);
+  for_each_chunk(static_cast<std::size_t>(w.n_input), chunk, opt.n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t)
+      if (const double q = w.q(static_cast<std::int32_t>(t)); q < below) bad_in[c].push_back({q, static_cast<std::int32_t>(t)});
+  });
   std::vector<Entry> bad;
-  for (std::int32_t t = 0; t < w.n_input; ++t)
-    if (const double q = w.q(t); q < below) bad.push_back({q, t});
+  for (const auto& b : bad_in) bad.insert(bad.end(), b.begin(), b.end());
+  bad_in.clear();
   if (bad.empty()) return {};
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> todo(std::greater<>{}, std::move(bad));
   w.alive.assign(static_cast<std::size_t>(w.n_input), 1);
@@ -273,7 +281,7 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
       [&](std::size_t e, auto&& f) {
         for (const std::int32_t u : w.tet(static_cast<std::int32_t>(e))) f(u);
       },
-      1, w.at_start, w.at_list);
+      opt.n_threads, w.at_start, w.at_list);
   w.at_added.resize(n);
   w.node_faces.resize(n);
   for (std::size_t f = 0; f < mesh.interface.size(); ++f) {

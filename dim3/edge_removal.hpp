@@ -35,6 +35,9 @@ struct EdgeRemovalOptions {
   /// normals at its nodes does not drop, and stays positive), and never an edge between two
   /// feature-line or corner nodes (it may be the feature line itself).
   std::function<Point<3>(const BoundaryLocation&)> surface_normal;
+  /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
+  /// on one); the result is the same for every count.
+  int n_threads = 1;
 };
 
 struct EdgeRemovalStats {

@@ -903,6 +903,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           // volume share 0.999 -> 0.459).
           if (opt.hex_dominant) eo.below_deg = std::min(eo.below_deg, opt.hex.min_dihedral_deg);
           eo.surface_normal = surface_normal;
+          eo.n_threads = opt.n_threads;
           for (int round = 0; round < 3; ++round) {
             const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
             r.n_edges_removed += es.removed;
