@@ -782,7 +782,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       say("finite elements: templates");
       // Feature snaps that invert an element are undone, then the templates are redone.
       for (int round = 0;; ++round) {
-        fe = tetrahedralize(tree, oc.complex, surface_point);
+        fe = tetrahedralize(tree, oc.complex, surface_point, opt.n_threads);
         {
           // Untangle by moving nodes (interior ones freely, surface ones on the surface,
           // corners not at all) before giving up snaps or refining.

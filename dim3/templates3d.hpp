@@ -46,7 +46,10 @@ struct TetMesh {
 };
 
 /// Node ids 0..complex.points.size()-1 of the result are the complex's nodes.
-TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& complex, const SurfacePointFn& surface_point);
+/// The interior octants' tetrahedra are built on n_threads threads; the result is the same for
+/// every count.
+TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& complex, const SurfacePointFn& surface_point,
+                       int n_threads = 1);
 
 /// The triangles (outward, CCW seen from outside the cell) of a lattice square face with
 /// corners `q` counter-clockwise seen from outside, by the face rule above. `lattice_node`
