@@ -138,5 +138,17 @@ TEST_CASE("templates are conforming on random 2:1 octrees", "[templates3d][prope
     RC_LOG() << r.summary();
     RC_ASSERT(r.valid);
     RC_ASSERT(std::abs(solid_measure<3>(m.mesh) - std::pow(0.75, 3)) < 1e-9);
+    // The interior octants are built on threads: the same nodes and tetrahedra on any count.
+    for (const int n_threads : {2, 3}) {
+      const TetMesh mt = tetrahedralize(t, oc, {}, n_threads);
+      RC_ASSERT(mt.mesh.points == m.mesh.points);
+      RC_ASSERT(mt.mesh.solid.node == m.mesh.solid.node);
+      RC_ASSERT(mt.mesh.solid.offset == m.mesh.solid.offset);
+      RC_ASSERT(mt.mesh.level == m.mesh.level);
+      RC_ASSERT(mt.mesh.from_boundary_cell == m.mesh.from_boundary_cell);
+      RC_ASSERT(mt.cell == m.cell);
+      RC_ASSERT(mt.mesh.interface.node == m.mesh.interface.node);
+      RC_ASSERT(mt.n_dropped_degenerate == m.n_dropped_degenerate);
+    }
   });
 }
