@@ -230,6 +230,7 @@ int run(const std::vector<std::string>& argv) {
                            {"hex_rejected", r.hex.n_hex_rejected},
                            {"hex_demoted", r.hex.n_hex_demoted},
                            {"faces_split", r.hex.n_faces_split},
+                           {"tets_min_dihedral_deg", r.hex.tets_min_dihedral_deg},
                            {"min_hex_scaled_jacobian", opt.hex.min_hex_scaled_jacobian},
                            {"min_scaled_jacobian", q.min_scaled_jacobian}};
   rep["fidelity"] = {{"surface_volume", fid.surface_volume},

@@ -247,6 +247,10 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   const auto keeps_dihedral = [&](double merged, double cones) {
     return !dihedral_rule || merged >= std::min(opt.min_dihedral_deg, cones);
   };
+  for (std::size_t e = 0; e < m.solid.size(); ++e)
+    st.tets_min_dihedral_deg = std::min(
+        st.tets_min_dihedral_deg,
+        min_dihedral(ElemType::Tet4, element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, pts).span()));
   for (CellInfo& ci : cells) {
     for (QuadFace& q : ci.quads) {
       const auto ep = points_of(pts, {q.ring[0], q.ring[3], q.ring[2], q.ring[1], ci.apex});

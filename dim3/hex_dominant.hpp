@@ -51,6 +51,9 @@ struct HexDominantStats {
   std::size_t n_faces_split = 0;      ///< plain quad faces split back into two triangles
   std::size_t n_interface_quads = 0, n_interface_triangles = 0;
   double hex_volume = 0.0, total_volume = 0.0;
+  /// Smallest dihedral angle (degrees) of the tetrahedra it started from: the merged mesh's is
+  /// at least min(HexDominantOptions::min_dihedral_deg, this).
+  double tets_min_dihedral_deg = 180.0;
 
   std::size_t n_elements() const { return n_hex + n_pyramid + n_tet; }
   /// Hexes over all solid elements.

@@ -362,9 +362,17 @@ TEST_CASE("hex-dominant meshes of tori and voxel unions are valid when the tet m
       RC_ASSERT(v.valid);
       const double fe = solid_measure<3>(r.fe.mesh), be = interface_enclosed_measure<3>(r.fe.mesh);
       RC_ASSERT(std::abs(fe - be) <= 1e-10 * std::abs(be));
-      // The merges keep the tets' smallest dihedral angle, up to HexDominantOptions::min_dihedral_deg.
+      // The merges keep the smallest dihedral angle of the tets they start from, up to
+      // HexDominantOptions::min_dihedral_deg. Those are the tet run's only when both runs took
+      // the same path: the thickness retry stands when it loses less volume, and a hex mesh's
+      // volume is not its tets' (warped quads), so the runs can keep different meshes
+      // (shrunk voxel union, session 17: first meshes 7.45% / 6.99%, retries 7.46% / 6.81%:
+      // the hex run kept its first mesh, the tet run its retry; 13.68 deg against 26.91).
       const double tet_min = summarize_quality<3>(tet.fe.mesh).min_angle_deg;
-      RC_ASSERT(summarize_quality<3>(r.fe.mesh).min_angle_deg >= std::min(opt.hex.min_dihedral_deg, tet_min) - 1e-9);
+      const double hex_min = summarize_quality<3>(r.fe.mesh).min_angle_deg;
+      RC_ASSERT(hex_min >= std::min(opt.hex.min_dihedral_deg, r.hex.tets_min_dihedral_deg) - 1e-9);
+      if (r.thickness_refined == tet.thickness_refined && r.level_raised == tet.level_raised)
+        RC_ASSERT(hex_min >= std::min(opt.hex.min_dihedral_deg, tet_min) - 1e-9);
     };
   };
   test::prop("tori, --elements hex", 4, when_tets_valid(test::gen_torus_spec()));
