@@ -156,10 +156,16 @@ std::pair<Eigen::Vector3d, double> barycentric(const Point<3>& p, const Point<3>
   return {Eigen::Vector3d(l0, l1, 1.0 - l0 - l1), std::abs((p - a).dot(n)) / std::sqrt(n2)};
 }
 
-/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
-bool on_facet_interior(const Point<3>& p, const Facet& f, const std::vector<Point<3>>& pts, double rel) {
+/// The size of a facet: its longest edge.
+double facet_size(const Facet& f, const std::vector<Point<3>>& pts) {
   double h = 0.0;
   for (int i = 0; i < f.n; ++i) h = std::max(h, (pts[f.node[(i + 1) % f.n].v] - pts[f.node[i].v]).norm());
+  return h;
+}
+
+/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
+/// h is facet_size(f, pts), computed once per facet by the caller.
+bool on_facet_interior(const Point<3>& p, const Facet& f, double h, const std::vector<Point<3>>& pts, double rel) {
   if (h == 0.0) return false;
   const auto& a = pts[f.node[0].v];
   if (f.n == 3) {
@@ -525,17 +531,14 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       const auto on_interior = [&](std::size_t i, const auto& at) {
         const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
         Box<3> box = Box<3>::empty();
-        double h = 0.0;
-        for (int k = 0; k < f.n; ++k) {
-          box.expand(pts[f.node[k].v]);
-          h = std::max(h, (pts[f.node[(k + 1) % f.n].v] - pts[f.node[k].v]).norm());
-        }
+        for (int k = 0; k < f.n; ++k) box.expand(pts[f.node[k].v]);
+        const double h = facet_size(f, pts);  // once per facet, not once per node tested
         box.lo.array() -= rel * h;
         box.hi.array() += rel * h;
         grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
-          if (on_facet_interior(pts[c], f, pts, rel)) at(c);
+          if (on_facet_interior(pts[c], f, h, pts, rel)) at(c);
         });
       };
       const std::vector<std::uint8_t> facet_hit = marked(uses.size(), [&](std::size_t i) {
