@@ -347,13 +347,27 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   }
 
   // Conformity: group facet uses by key.
-  const std::vector<FacetUse> uses = facet_uses(mesh.solid);
+  std::vector<FacetUse> uses = facet_uses(mesh.solid);
   std::vector<FacetUse> boundary;  // used once; sorted by key
   std::size_t n_unique_facets = 0;  // (a count: the list of keys was 24 B/element at the CLI's peak)
+  // 3D: each distinct facet's first use, in key order, for the hanging-node check below; the
+  // uses (24 B each, 96 B a tetrahedron) are freed after this loop, not kept to the end, where
+  // they were the CLI's memory peak beside the edge list.
+  struct FirstUse {
+    ElemId elem;
+    std::int8_t local = 0;
+  };
+  std::vector<FirstUse> first_uses;
+  if constexpr (Dim == 3) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < uses.size(); ++i) n += i == 0 || uses[i].key != uses[i - 1].key;
+    first_uses.reserve(n);
+  }
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i + 1;
     while (j < uses.size() && uses[j].key == uses[i].key) ++j;
     ++n_unique_facets;
+    if constexpr (Dim == 3) first_uses.push_back({uses[i].elem, uses[i].local});
     if (j - i == 1) {
       boundary.push_back(uses[i]);
     } else if (j - i > 2 || uses[i].orientation == uses[i + 1].orientation) {
@@ -367,6 +381,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     }
     i = j;
   }
+  std::vector<FacetUse>().swap(uses);
 
   // A quad facet against two triangles on its four nodes (a hex beside two tets) leaves all three
   // used once, so the grouping above cannot see it, and an interface listing all three would match.
@@ -527,9 +542,9 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       }
     }
     if constexpr (Dim == 3) {
-      // Calls at(c) for every node c on the interior of use i's facet.
+      // Calls at(c) for every node c on the interior of the i-th distinct facet.
       const auto on_interior = [&](std::size_t i, const auto& at) {
-        const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
+        const Facet f = facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local);
         Box<3> box = Box<3>::empty();
         for (int k = 0; k < f.n; ++k) box.expand(pts[f.node[k].v]);
         const double h = facet_size(f, pts);  // once per facet, not once per node tested
@@ -541,14 +556,16 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
           if (on_facet_interior(pts[c], f, h, pts, rel)) at(c);
         });
       };
-      const std::vector<std::uint8_t> facet_hit = marked(uses.size(), [&](std::size_t i) {
-        if (i > 0 && uses[i].key == uses[i - 1].key) return false;
+      const std::vector<std::uint8_t> facet_hit = marked(first_uses.size(), [&](std::size_t i) {
         bool hit = false;
         on_interior(i, [&](std::int32_t) { hit = true; });
         return hit;
       });
-      for (std::size_t i = 0; i < uses.size(); ++i)
-        if (facet_hit[i]) on_interior(i, [&](std::int32_t c) { report(c, "facet " + fmt_key(uses[i].key)); });
+      for (std::size_t i = 0; i < first_uses.size(); ++i)
+        if (facet_hit[i])
+          on_interior(i, [&](std::int32_t c) {
+            report(c, "facet " + fmt_key(key_of(facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local))));
+          });
     }
   }
 
