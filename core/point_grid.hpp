@@ -55,13 +55,19 @@ template <int Dim> class PointGrid {
       if (!(box.lo[d] <= box.hi[d])) return;  // empty (or NaN): contains nothing
       lo[d] = coord(box.lo[d], d), hi[d] = coord(box.hi[d], d);
     }
+    // The cells lo[0]..hi[0] of a row (the other coordinates fixed) are consecutive, and so are
+    // their points: one run of ids per row, not one per cell (the same visits in the same order;
+    // the per-cell index and bounds were most of the 3D validator's hanging-node queries).
     at = lo;
     for (;;) {
       std::size_t c = 0;
       for (int d = Dim - 1; d >= 0; --d) c = c * static_cast<std::size_t>(k_[d]) + static_cast<std::size_t>(at[d]);
-      for (std::int32_t i = start_[c]; i < start_[c + 1]; ++i)
-        if (box.contains(pts_[ids_[static_cast<std::size_t>(i)]])) visit(ids_[static_cast<std::size_t>(i)]);
-      int d = 0;
+      const std::int32_t end = start_[c + static_cast<std::size_t>(hi[0] - lo[0]) + 1];
+      for (std::int32_t i = start_[c]; i < end; ++i) {
+        const std::int32_t id = ids_[static_cast<std::size_t>(i)];
+        if (box.contains(pts_[static_cast<std::size_t>(id)])) visit(id);
+      }
+      int d = 1;
       while (d < Dim && at[d] == hi[d]) at[d] = lo[d], ++d;
       if (d == Dim) return;
       ++at[d];

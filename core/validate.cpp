@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numeric>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <type_traits>
 
@@ -156,10 +157,16 @@ std::pair<Eigen::Vector3d, double> barycentric(const Point<3>& p, const Point<3>
   return {Eigen::Vector3d(l0, l1, 1.0 - l0 - l1), std::abs((p - a).dot(n)) / std::sqrt(n2)};
 }
 
-/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
-bool on_facet_interior(const Point<3>& p, const Facet& f, const std::vector<Point<3>>& pts, double rel) {
+/// The size of a facet: its longest edge.
+double facet_size(const Facet& f, const std::vector<Point<3>>& pts) {
   double h = 0.0;
   for (int i = 0; i < f.n; ++i) h = std::max(h, (pts[f.node[(i + 1) % f.n].v] - pts[f.node[i].v]).norm());
+  return h;
+}
+
+/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
+/// h is facet_size(f, pts), computed once per facet by the caller.
+bool on_facet_interior(const Point<3>& p, const Facet& f, double h, const std::vector<Point<3>>& pts, double rel) {
   if (h == 0.0) return false;
   const auto& a = pts[f.node[0].v];
   if (f.n == 3) {
@@ -182,6 +189,109 @@ template <int Dim> Box<Dim> inflated_box(std::initializer_list<Point<Dim>> corne
   return b;
 }
 
+
+/// facet_uses(solid) grouped by key: the groups in key order, each group's uses in (element,
+/// local facet) order, the same as facet_uses gives them. A solid of tetrahedra is held at 12
+/// bytes a use (the smallest node implied by a bucket, the other two and a packed element and
+/// facet), its FacetUse records made per group: facet_uses' 24 bytes a use (96 a tetrahedron)
+/// were the CLI's memory peak in the validation (sphere966 level 6).
+class FacetGroups {
+ public:
+  explicit FacetGroups(const Elements& els) : els_(els) {
+    tets_ = els.size() < (std::size_t(1) << 29) &&
+            std::all_of(els.type.begin(), els.type.end(), [](ElemType t) { return t == ElemType::Tet4; });
+    if (!tets_) {
+      uses_ = facet_uses(els);
+      for (std::size_t i = 0; i < uses_.size(); ++i) n_groups_ += i == 0 || uses_[i].key != uses_[i - 1].key;
+      return;
+    }
+    std::int32_t top = -1;  // node ids are in range (validate checked the elements)
+    for (const VertexId v : els.node) top = std::max(top, v.v);
+    start_.assign(static_cast<std::size_t>(top) + 2, 0);
+    // Calls visit(sorted key nodes a <= b <= c, element << 2 | local facet) per use, in
+    // (element, local facet) order. Facet f of a tetrahedron (Gmsh's table) is the triple
+    // without node 3 - f; its key is that triple sorted.
+    const auto each_use = [&](auto&& visit) {
+      for (std::size_t e = 0; e < els.size(); ++e) {
+        const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+        for (int f = 0; f < 4; ++f) {
+          std::int32_t t[3], m = 0;
+          for (int i = 0; i < 4; ++i)
+            if (i != 3 - f) t[m++] = v[i].v;
+          if (t[0] > t[1]) std::swap(t[0], t[1]);
+          if (t[1] > t[2]) std::swap(t[1], t[2]);
+          if (t[0] > t[1]) std::swap(t[0], t[1]);
+          visit(t[0], t[1], t[2], static_cast<std::uint32_t>(e << 2 | std::size_t(f)));
+        }
+      }
+    };
+    each_use([&](std::int32_t a, std::int32_t, std::int32_t, std::uint32_t) { ++start_[static_cast<std::size_t>(a) + 1]; });
+    for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+    packed_.resize(start_.back());
+    {
+      std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+      each_use([&](std::int32_t a, std::int32_t b, std::int32_t c, std::uint32_t id) {
+        packed_[fill[static_cast<std::size_t>(a)]++] = {b, c, id};
+      });
+    }
+    // Generation order is (element, local facet): a stable sort by the rest of the key.
+    const auto less = [](const Packed& x, const Packed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; };
+    for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
+      const auto first = packed_.begin() + start_[b], last = packed_.begin() + start_[b + 1];
+      if (last - first > 32) {
+        std::stable_sort(first, last, less);
+      } else {
+        for (auto i = first + (first != last); i < last; ++i)
+          for (auto j = i; j != first && less(*j, *(j - 1)); --j) std::iter_swap(j, j - 1);
+      }
+      for (auto i = first; i < last; ++i) n_groups_ += i == first || less(*(i - 1), *i);
+    }
+  }
+
+  std::size_t n_groups() const { return n_groups_; }
+
+  /// Calls group(std::span<const FacetUse>) for every distinct key, in key order.
+  template <class Group> void for_each(Group&& group) const {
+    if (!tets_) {
+      for (std::size_t i = 0; i < uses_.size();) {
+        std::size_t j = i + 1;
+        while (j < uses_.size() && uses_[j].key == uses_[i].key) ++j;
+        group(std::span<const FacetUse>(uses_.data() + i, j - i));
+        i = j;
+      }
+      return;
+    }
+    std::vector<FacetUse> g;
+    for (std::size_t b = 0; b + 1 < start_.size(); ++b)
+      for (std::uint32_t i = start_[b]; i < start_[b + 1];) {
+        std::uint32_t j = i + 1;
+        while (j < start_[b + 1] && packed_[j].k1 == packed_[i].k1 && packed_[j].k2 == packed_[i].k2) ++j;
+        g.clear();
+        for (std::uint32_t k = i; k < j; ++k) {
+          const ElemId e{static_cast<std::int32_t>(packed_[k].id >> 2)};
+          const int local = static_cast<int>(packed_[k].id & 3u);
+          FacetUse u{FacetKey{}, e, static_cast<std::int8_t>(local),
+                     static_cast<std::int8_t>(orientation_of(facet_of(els_, e, local)))};
+          u.key.v = {static_cast<std::int32_t>(b), packed_[k].k1, packed_[k].k2, -1};
+          g.push_back(u);
+        }
+        group(std::span<const FacetUse>(g));
+        i = j;
+      }
+  }
+
+ private:
+  struct Packed {
+    std::int32_t k1, k2;  ///< the key's second and third node
+    std::uint32_t id;     ///< element << 2 | local facet
+  };
+  const Elements& els_;
+  bool tets_ = false;
+  std::size_t n_groups_ = 0;
+  std::vector<FacetUse> uses_;         ///< other element types: facet_uses
+  std::vector<std::uint32_t> start_;   ///< tetrahedra: bucket b (smallest node b) is packed_[start_[b], start_[b + 1])
+  std::vector<Packed> packed_;
+};
 }  // namespace
 
 std::string ValidationReport::summary() const {
@@ -341,25 +451,33 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   }
 
   // Conformity: group facet uses by key.
-  const std::vector<FacetUse> uses = facet_uses(mesh.solid);
   std::vector<FacetUse> boundary;  // used once; sorted by key
   std::size_t n_unique_facets = 0;  // (a count: the list of keys was 24 B/element at the CLI's peak)
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
-    ++n_unique_facets;
-    if (j - i == 1) {
-      boundary.push_back(uses[i]);
-    } else if (j - i > 2 || uses[i].orientation == uses[i + 1].orientation) {
-      ++r.nonconforming_facets;
-      problems.add("a facet does not conform", uses[i].key.v[0], [&](auto& os) {
-        os << "facet " << fmt_key(uses[i].key) << " used " << (j - i) << " times"
-           << (j - i == 2 ? " in the same orientation" : "") << " by solid elements";
-        for (std::size_t k = i; k < j; ++k) os << " " << uses[k].elem.v;
-        os << " at " << fmt<Dim>(pts[uses[i].key.v[0]]);
-      });
-    }
-    i = j;
+  // 3D: each distinct facet's first use, in key order, for the hanging-node check below (the
+  // groups are freed after this loop, not kept to the end beside the edge list).
+  struct FirstUse {
+    ElemId elem;
+    std::int8_t local = 0;
+  };
+  std::vector<FirstUse> first_uses;
+  {
+    const FacetGroups groups(mesh.solid);
+    if constexpr (Dim == 3) first_uses.reserve(groups.n_groups());
+    groups.for_each([&](std::span<const FacetUse> g) {
+      ++n_unique_facets;
+      if constexpr (Dim == 3) first_uses.push_back({g[0].elem, g[0].local});
+      if (g.size() == 1) {
+        boundary.push_back(g[0]);
+      } else if (g.size() > 2 || g[0].orientation == g[1].orientation) {
+        ++r.nonconforming_facets;
+        problems.add("a facet does not conform", g[0].key.v[0], [&](auto& os) {
+          os << "facet " << fmt_key(g[0].key) << " used " << g.size() << " times"
+             << (g.size() == 2 ? " in the same orientation" : "") << " by solid elements";
+          for (const FacetUse& u : g) os << " " << u.elem.v;
+          os << " at " << fmt<Dim>(pts[g[0].key.v[0]]);
+        });
+      }
+    });
   }
 
   // A quad facet against two triangles on its four nodes (a hex beside two tets) leaves all three
@@ -521,31 +639,30 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       }
     }
     if constexpr (Dim == 3) {
-      // Calls at(c) for every node c on the interior of use i's facet.
+      // Calls at(c) for every node c on the interior of the i-th distinct facet.
       const auto on_interior = [&](std::size_t i, const auto& at) {
-        const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
+        const Facet f = facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local);
         Box<3> box = Box<3>::empty();
-        double h = 0.0;
-        for (int k = 0; k < f.n; ++k) {
-          box.expand(pts[f.node[k].v]);
-          h = std::max(h, (pts[f.node[(k + 1) % f.n].v] - pts[f.node[k].v]).norm());
-        }
+        for (int k = 0; k < f.n; ++k) box.expand(pts[f.node[k].v]);
+        const double h = facet_size(f, pts);  // once per facet, not once per node tested
         box.lo.array() -= rel * h;
         box.hi.array() += rel * h;
         grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
-          if (on_facet_interior(pts[c], f, pts, rel)) at(c);
+          if (on_facet_interior(pts[c], f, h, pts, rel)) at(c);
         });
       };
-      const std::vector<std::uint8_t> facet_hit = marked(uses.size(), [&](std::size_t i) {
-        if (i > 0 && uses[i].key == uses[i - 1].key) return false;
+      const std::vector<std::uint8_t> facet_hit = marked(first_uses.size(), [&](std::size_t i) {
         bool hit = false;
         on_interior(i, [&](std::int32_t) { hit = true; });
         return hit;
       });
-      for (std::size_t i = 0; i < uses.size(); ++i)
-        if (facet_hit[i]) on_interior(i, [&](std::int32_t c) { report(c, "facet " + fmt_key(uses[i].key)); });
+      for (std::size_t i = 0; i < first_uses.size(); ++i)
+        if (facet_hit[i])
+          on_interior(i, [&](std::int32_t c) {
+            report(c, "facet " + fmt_key(key_of(facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local))));
+          });
     }
   }
 

@@ -431,6 +431,14 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     }
     b.cones(tris, centre, bo.cell.level, true, n_interior + static_cast<std::int32_t>(k));
   }
+  // The arrays grew by doubling (up to twice their size); they are kept through smoothing and
+  // edge removal, whose new element arrays make the pipeline's memory peak beside them.
+  for (auto* v : {&b.out.mesh.solid.offset, &b.out.cell}) v->shrink_to_fit();
+  for (auto* v : {&b.out.mesh.level, &b.out.mesh.from_boundary_cell}) v->shrink_to_fit();
+  b.out.mesh.solid.type.shrink_to_fit();
+  b.out.mesh.solid.node.shrink_to_fit();
+  b.out.mesh.points.shrink_to_fit();
+  b.out.where.shrink_to_fit();
   return std::move(b.out);
 }
 

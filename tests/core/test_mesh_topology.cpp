@@ -80,6 +80,11 @@ TEST_CASE("linear topology: a node shared by many elements (long bucket)", "[mes
     for (int k = 1; k <= 100; ++k) els.add(ElemType::Tri3, {VertexId{0}, VertexId{k}, VertexId{k % 100 + 1}});
   check_same_as_ref(els);
   CHECK(boundary_facets(els).empty());  // every facet is used twice
+
+  Elements tets;  // 60 tetrahedra around the axis 0-61, each listed twice: equal keys in a long bucket
+  for (int rep = 0; rep < 2; ++rep)
+    for (int k = 1; k <= 60; ++k) tets.add(ElemType::Tet4, {VertexId{0}, VertexId{k}, VertexId{k % 60 + 1}, VertexId{61}});
+  check_same_as_ref(tets);
 }
 
 TEST_CASE("linear topology = comparison-sort twins on element soups", "[mesh][property]") {

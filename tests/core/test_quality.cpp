@@ -3,8 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <random>
 
 #include "core/quality.hpp"
 #include "test_mesh_fixtures.hpp"
@@ -185,5 +189,31 @@ TEST_CASE("the tetrahedra's summary equals element_quality's, bit for bit", "[qu
     CHECK(s.max_aspect_ratio == aspect);
     CHECK(s.max_radius_ratio == radius);
     CHECK(s.n_slivers == static_cast<std::size_t>(std::lower_bound(mins.begin(), mins.end(), th) - mins.begin()));
+  }
+}
+
+TEST_CASE("a tetrahedron's min corner Jacobian is its four corners', bit for bit", "[quality]") {
+  // The slow twin: each corner (c; a, b, d) of Gmsh's right-handed order, J = (a - c) . ((b - c) x (d - c)),
+  // the minimum taken from infinity (a NaN corner is passed over).
+  constexpr int corner[4][4] = {{0, 1, 2, 3}, {1, 2, 0, 3}, {2, 0, 1, 3}, {3, 0, 2, 1}};
+  const auto reference = [&](const std::array<Point<3>, 4>& p) {
+    double m = std::numeric_limits<double>::infinity();
+    for (const auto& k : corner)
+      m = std::min(m, (p[k[1]] - p[k[0]]).dot((p[k[2]] - p[k[0]]).cross(p[k[3]] - p[k[0]])));
+    return m;
+  };
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 2000; ++i) {
+    std::array<Point<3>, 4> p;
+    for (auto& x : p) x = Point<3>(u(rng), u(rng), u(rng));
+    if (i % 7 == 0) p[3] = 0.5 * (p[0] + p[1]);  // degenerate
+    if (i % 11 == 0) p[2] = p[1] + Point<3>::Constant(1e-300);
+    if (i % 13 == 0) p[1][0] = std::nan("");
+    const double got = min_corner_jacobian<3>(ElemType::Tet4, {p.data(), 4});
+    const double want = reference(p);
+    CHECK(std::bit_cast<std::uint64_t>(got) == std::bit_cast<std::uint64_t>(want));
+    CHECK(std::bit_cast<std::uint64_t>(jacobians<3>(ElemType::Tet4, {p.data(), 4}).first) ==
+          std::bit_cast<std::uint64_t>(want));
   }
 }

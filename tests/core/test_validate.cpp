@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include "core/mesh_topology.hpp"
+#include "core/quality.hpp"
 #include "core/validate.hpp"
 #include "test_mesh_fixtures.hpp"
 
@@ -64,6 +65,42 @@ TEMPLATE_TEST_CASE_SIG("the classic 2:1 hanging node is detected", "[validate]",
     CHECK(r.hanging_nodes == (Dim == 2 ? 1u : 5u));
     CHECK(r.unused_nodes == 0);
   }
+}
+
+TEST_CASE("a node on an inner facet of an overlapping tetrahedron hangs", "[validate]") {
+  // Every inner facet of a tetrahedral grid gets a far tetrahedron whose apex sits at the facet's
+  // centroid: the apex is on the interior of a facet used twice (not a boundary facet), which
+  // only the geometric facet check sees; it is reported as hanging, once, naming a facet.
+  const Mesh<3> grid = test::grid_mesh<3>(2, true);
+  const std::vector<FacetUse> uses = facet_uses(grid.solid);
+  std::size_t n_inner = 0;
+  for (std::size_t i = 0; i + 1 < uses.size(); ++i) {
+    if (uses[i].key != uses[i + 1].key) continue;
+    ++n_inner;
+    Mesh<3> mesh = grid;
+    const Facet f = facet_of(mesh.solid, uses[i].elem, uses[i].local);
+    const Point<3> c = (mesh.points[f.node[0].v] + mesh.points[f.node[1].v] + mesh.points[f.node[2].v]) / 3.0;
+    const VertexId apex = mesh.add_point(c), a = mesh.add_point(Point<3>(10, 10, 10)),
+                   b = mesh.add_point(Point<3>(11, 10, 10)), d = mesh.add_point(Point<3>(10, 11, 10));
+    const VertexId v[4] = {apex, a, b, d};
+    mesh.solid.add(ElemType::Tet4, v, 4);
+    if (min_corner_jacobian<3>(ElemType::Tet4, element_points<3>(mesh.solid, ElemId{static_cast<std::int32_t>(mesh.solid.size() - 1)}, mesh.points).span()) < 0)
+      std::swap(mesh.solid.node[mesh.solid.node.size() - 1], mesh.solid.node[mesh.solid.node.size() - 2]);
+    mesh.level.push_back(0);
+    mesh.from_boundary_cell.push_back(0);
+    ValidateOptions<3> opt;
+    opt.check_interface = false;
+    const ValidationReport r = validate(mesh, opt);
+    INFO(r.summary());
+    CHECK(r.inverted == 0);
+    CHECK(r.nonconforming_facets == 0);
+    CHECK(r.hanging_nodes == 1);
+    REQUIRE(r.problems.size() == 1);
+    CHECK(r.problems[0].find("hanging node " + std::to_string(apex.v)) != std::string::npos);
+    CHECK(r.problems[0].find("on facet") != std::string::npos);
+    ++i;
+  }
+  CHECK(n_inner > 0);
 }
 
 TEMPLATE_TEST_CASE_SIG("duplicated element and facets are non-conforming", "[validate]", ((int Dim), Dim), 2, 3) {
