@@ -172,6 +172,7 @@ int run(const std::vector<std::string>& argv) {
                     {"feature_snapping_dropped", r.features_dropped},
                     {"facing_projection", r.facing_projection},
                     {"thickness_refined", r.thickness_refined},
+                    {"thickness_after_refusal", r.thickness_after_refusal},
                     {"level_raised", r.level_raised}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},

@@ -505,9 +505,53 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 }  // namespace
 
+/// mesh3d_raised's refusal `e` (after `effort`): once more with the thickness level when part of
+/// the solid is thin (Options3d::refused_thickness_cells); when that is refused too, `e` again
+/// (the same type), with the second refusal's reason.
+template <class E>
+Result3d thickness_after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& effort, const E& e,
+                                 const Progress3& progress) {
+  const double cells = opt.refused_thickness_cells;
+  if (!(cells > 0) || opt.thickness_cells > 0) throw e;
+  // Only where the thickness level passes the feature level (level + 1), else the first tree is
+  // the one refused already.
+  const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
+  if (!(s.thin_share(cells * h_feature) > 0)) throw e;
+  Options3d thick = opt;
+  thick.thickness_cells = cells;
+  thick.buffer = 0.0;  // its one-octant slabs in thin parts project through them (thin retry)
+  thick.raise_levels = 0;
+  thick.effort = std::min(opt.effort, opt.thin_retry_effort);
+  thick.min_effort_octants = 0;
+  if (progress)
+    progress(std::string("refused (") + e.what() + "): once more with " + std::to_string(cells) +
+             " octants across the thin parts, without the buffer rule");
+  Effort thick_effort;
+  std::string why;
+  try {
+    Result3d t = mesh3d_facing(s, thick, thick_effort, progress);
+    t.n_octants_built = effort.used + thick_effort.used;
+    t.thickness_after_refusal = true;
+    return t;
+  } catch (const GeometryError& f) {
+    why = f.what();
+  } catch (const LimitError& f) {
+    why = f.what();
+  }
+  s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+  throw E(std::string(e.what()) + "; with " + std::to_string(cells) + " octants across the thin parts: " + why);
+}
+
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   Effort effort;
-  Result3d r = mesh3d_raised(s, opt, effort, progress);
+  Result3d r;
+  try {
+    r = mesh3d_raised(s, opt, effort, progress);
+  } catch (const GeometryError& e) {
+    return thickness_after_refusal(s, opt, effort, e, progress);
+  } catch (const LimitError& e) {
+    return thickness_after_refusal(s, opt, effort, e, progress);
+  }
   r.n_octants_built = effort.used;
   Options3d ran = opt;  // the thickness retry below is at the level the mesh was made at
   ran.level += r.level_raised;
@@ -702,7 +746,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       if (opt.thin_cells > 0) {
         // The rest of such parts: the octants on surface thinner than thin_cells of their size,
         // whose handles would be lost without an island to show it.
-        const std::vector<double>& thickness = s.thicknesses();
+        const std::vector<double>& thickness = s.centroid_thicknesses();
         for (std::size_t i = 0; i < tree.n_leaves(); ++i) {
           if (sides[i] != Side::Partial || tree.leaf(i).level >= max_level || flags[i]) continue;
           const Box<3> b = geometry(tree, tree.leaf(i));

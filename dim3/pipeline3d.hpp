@@ -91,7 +91,7 @@ struct Options3d {
   int island_refinements = 3;
   double island_cells = 2.0;
   /// With an island refinement, also split the octants on the surface whose triangles are
-  /// thinner (SurfaceBoundary::thickness) than this x their size; 0 = off.
+  /// thinner (SurfaceBoundary::centroid_thickness) than this x their size; 0 = off.
   double thin_cells = 1.5;
   /// An island refinement that would split more than this share of the leaves is tried once
   /// per run and kept only if no island is left (a tube two octants thick: resolved; rotor's
@@ -113,6 +113,17 @@ struct Options3d {
   /// a valid mesh, so it gets less room than the first run (rotor L4: its 3 tries on 198k-313k
   /// octants cost 190 s CPU on top of the first run's 70 s, and lost as much volume).
   double thin_retry_effort = 10.0;
+  /// When every try is refused (GeometryError or LimitError) and part of the solid is thinner
+  /// than this many octants of level + 1 (where the thickness level passes the feature level),
+  /// run once more with this many octants across every part (thickness_cells) from the first
+  /// tree, up to level + thickness_extra_levels, without the buffer rule and within its own
+  /// work bound of thin_retry_effort (Result3d::thickness_after_refusal). 0 = off. Boundary
+  /// octants fold where a sheet is 1-3 octants thick: its face nodes lie nearer the far sheet,
+  /// and refining around the folds moves them along a taper. Measured (spool L6, whose right
+  /// flange's lip tapers from 0.022 to 0.010, 1-3 level-7 octants: refused after 795 s CPU):
+  /// with 4 octants across, up to level 8, the first try is valid without a repair (diagnose3d
+  /// --single --buffer 0: 3,186,715 tets, 11.05 deg, 0.16% volume error, 32 s CPU, 737 MB).
+  double refused_thickness_cells = 4.0;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   /// The work bound, so that no input runs for ever: the octants of every tree the boundary
@@ -152,6 +163,7 @@ struct Result3d {
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
+  bool thickness_after_refusal = false;  ///< refused; this run has Options3d::refused_thickness_cells' thickness level
   int level_raised = 0;              ///< refused at Options3d::level; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;

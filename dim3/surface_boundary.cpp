@@ -76,6 +76,14 @@ const std::vector<double>& SurfaceBoundary::thicknesses() {
   return thickness_;
 }
 
+const std::vector<double>& SurfaceBoundary::centroid_thicknesses() {
+  if (centroid_thickness_.empty()) {
+    centroid_thickness_.resize(surface_.n_triangles());
+    for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) centroid_thickness_[t] = centroid_thickness(t);
+  }
+  return centroid_thickness_;
+}
+
 double SurfaceBoundary::thin_share(double h) {
   const std::vector<double>& thick = thicknesses();
   double thin = 0.0, all = 0.0;
@@ -98,19 +106,41 @@ void SurfaceBoundary::set_thickness_level(double cells, double max_level) {
     if (std::isfinite(thick[t]) && thick[t] > 0) thickness_level_[t] = std::log2(root_side_ * cells / thick[t]);
 }
 
-double SurfaceBoundary::thickness(std::int32_t t) const {
-  const Triangle& tr = surface_.triangle(t);
-  const P3 centroid = (surface_.vertex(tr[0]) + surface_.vertex(tr[1]) + surface_.vertex(tr[2])) / 3.0;
+double SurfaceBoundary::thickness_from(std::int32_t t, const P3& from_point, std::int32_t vertex) const {
   const P3 n = surface_.normal(t).normalized();
-  const P3 from = centroid - 1e-9 * diagonal_ * n, to = centroid - diagonal_ * n;
-  double best = std::numeric_limits<double>::infinity();
+  const P3 from = from_point - 1e-9 * diagonal_ * n, to = from_point - diagonal_ * n;
+  // Hits nearer than this (share of the ray, which is one diagonal long) are the start's own
+  // surface met again by round-off.
+  const double near = 1e-7;
+  double first = std::numeric_limits<double>::infinity();
+  bool leaves = false;
   tree_.for_each_on_segment(from, to, [&](std::int32_t u) {
     if (u == t) return;
+    if (vertex >= 0) {
+      const Triangle& tu = surface_.triangle(u);
+      if (tu[0] == vertex || tu[1] == vertex || tu[2] == vertex) return;
+    }
     const auto& q = tree_.points(u);
     const double s = line_triangle_parameter(from, to, q[0], q[1], q[2]);
-    if (s > 0 && s < best) best = s;
+    if (!(s > near) || s > first) return;
+    // The ray runs along -n: it leaves the solid through u when u's outward normal is along it.
+    const bool out = surface_.normal(u).dot(n) < 0;
+    leaves = s < first ? out : (leaves || out);
+    first = s;
   });
-  return std::isfinite(best) && best > 0 ? best * diagonal_ : std::numeric_limits<double>::infinity();
+  return std::isfinite(first) && leaves ? first * diagonal_ : std::numeric_limits<double>::infinity();
+}
+
+double SurfaceBoundary::centroid_thickness(std::int32_t t) const {
+  const Triangle& tr = surface_.triangle(t);
+  return thickness_from(t, (surface_.vertex(tr[0]) + surface_.vertex(tr[1]) + surface_.vertex(tr[2])) / 3.0, -1);
+}
+
+double SurfaceBoundary::thickness(std::int32_t t) const {
+  const Triangle& tr = surface_.triangle(t);
+  double best = centroid_thickness(t);
+  for (std::int32_t v : tr) best = std::min(best, thickness_from(t, surface_.vertex(v), v));
+  return best;
 }
 
 SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptions options) {

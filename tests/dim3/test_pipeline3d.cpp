@@ -16,6 +16,7 @@
 #include "core/validate.hpp"
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
+#include "dim3/surface_checks.hpp"
 #include "dim3/tet_optimize.hpp"
 
 using namespace febemesh;
@@ -87,6 +88,49 @@ TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeli
   }
   INFO(what);
   CHECK(what.find("over its work bound of 6176") != std::string::npos);
+}
+
+// Options3d::refused_thickness_cells: a refused run has one more try with the thickness level
+// when part of the solid is thinner than that many octants of level + 1, and when that is refused
+// too the error is the first one's type, with both reasons. A plate 0.05 thick at level 3
+// (level-4 octants 0.066): a work bound under the first tree refuses every try at once.
+TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part", "[pipeline3d][thickness]") {
+  const double h = 0.05;
+  TriangleSoup soup;
+  soup.vertices = {P3(0, 0, 0), P3(1, 0, 0), P3(1, 1, 0), P3(0, 1, 0),
+                   P3(0, 0, h), P3(1, 0, h), P3(1, 1, h), P3(0, 1, h)};
+  soup.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                    {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  const auto refusal = [&](double cells) {
+    Surface surface(soup);
+    validate_surface(surface, "plate");
+    SurfaceBoundary s(std::move(surface));
+    Options3d opt;
+    opt.level = 3;
+    opt.effort = 0.5;
+    opt.min_effort_octants = 0;
+    opt.raise_levels = 0;
+    opt.refused_thickness_cells = cells;
+    std::string what;
+    try {
+      mesh3d(s, opt);
+    } catch (const LimitError& e) {
+      what = e.what();
+    }
+    return what;
+  };
+  const std::string with = refusal(4.0), without = refusal(0.0);
+  INFO(with);
+  CHECK(with.find("over its work bound") != std::string::npos);
+  CHECK(with.find("octants across the thin parts: the boundary octants could not be built within the work bound") !=
+        std::string::npos);
+  INFO(without);
+  CHECK(without.find("over its work bound") != std::string::npos);
+  CHECK(without.find("octants across the thin parts") == std::string::npos);
+  // Thicker than 0.1 octant of level 4 everywhere (a cube): no second try.
+  soup.vertices = {P3(0, 0, 0), P3(1, 0, 0), P3(1, 1, 0), P3(0, 1, 0),
+                   P3(0, 0, 1), P3(1, 0, 1), P3(1, 1, 1), P3(0, 1, 1)};
+  CHECK(refusal(0.1).find("octants across the thin parts") == std::string::npos);
 }
 
 // Options3d::faceted_free_ends: the same sphere's 30-degree creases are facets, most of them
@@ -162,11 +206,14 @@ TEST_CASE("tet_optimize untangles a displaced centre node and keeps the corners"
 
 // Threads (issue 8): the projections of the boundary octants, the classification, the smoothing
 // and the tet optimiser run on opt.n_threads; the mesh and the counts must not depend on it.
-// Spool at level 3: the first tree's projections include next local minima (4 of them).
+// Spool at level 3 without the thickness retry: the first tree's projections include next
+// local minima (22 of them, diagnose3d; the retry's tree had 4 while the thickness was measured
+// at the centroids only, none since it is the thinnest of centroid and vertices).
 TEST_CASE("mesh3d gives the same mesh and counts on 1 and 2 threads", "[pipeline3d][threads]") {
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off");
   Options3d opt;
   opt.level = 3;
+  opt.thin_retry_cells = 0;
   opt.n_threads = 1;
   const Result3d one = mesh3d(s, opt);
   opt.n_threads = 2;

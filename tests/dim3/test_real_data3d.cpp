@@ -135,6 +135,26 @@ TEST_CASE("mesh3d data: spool level 4 (its thin flanges kept by the thickness re
   CHECK(d.volume_rel_error < 0.05);
 }
 
+TEST_CASE("mesh3d data: spool level 6 with 4 octants across its thin parts (valid at its first tree)", "[data][pipeline3d][slow]") {
+  // Refused by the default tries (795 s CPU): its right flange ends in a lip tapering from 0.022
+  // to 0.010 thick, 1-3 level-7 octants, where the boundary octants fold. mesh3d's try after a
+  // refusal (Options3d::refused_thickness_cells), alone: 4 octants across every part (the
+  // thinnest of centroid and vertices, SurfaceBoundary::thickness), up to level 8, no buffer
+  // rule. Measured (diagnose3d --single --buffer 0): 3,186,715 tets, 11.05 deg, 0.16%, no
+  // repair, 32 s CPU, 737 MB.
+  Options3d opt;
+  opt.level = 6;
+  opt.thickness_cells = 4.0;
+  opt.buffer = 0.0;
+  opt.retry_facing = false;
+  opt.retry_without_buffer = false;
+  opt.raise_levels = 0;
+  opt.max_repairs = 0;
+  const DataRun d = mesh_and_validate("spool", opt);
+  CHECK(d.min_dihedral_deg >= 10.0);
+  CHECK(d.volume_rel_error < 0.01);
+}
+
 TEST_CASE("mesh3d data: fandisk level 4 (valid with facing projections only)", "[data][pipeline3d][slow]") {
   // Every try before fails at the thin lips (closest points on the far sheet fold the boundary
   // octants); the last one, projections leaving through every free face and landing on surface

@@ -156,3 +156,41 @@ TEST_CASE("level field: global, features, curvature, cap", "[surface_boundary]")
   const P3 c = sphere.bounding_box().center();
   CHECK(sphere.control_level(box(c.array() - 0.01 * r, c.array() + 0.01 * r)) == 0.0);
 }
+
+TEST_CASE("thickness: the thinnest of centroid and vertices along the inward normal", "[surface_boundary][thickness]") {
+  // (The rays start 1e-9 of the diagonal inside, hence the tolerance.)
+  // A tapered plate: bottom z = 0, top z = h0 + slope x over the unit square, end faces at
+  // x = 0 (h0 thick) and x = 1 (h1). From a point (x, y, z) of the top, the ray along the top's
+  // inward normal meets the bottom after z * sqrt(1 + slope^2); the thinnest is at x = 0.
+  const double h0 = 0.1, h1 = 0.3, slope = h1 - h0;
+  TriangleSoup soup;
+  soup.vertices = {P3(0, 0, 0), P3(1, 0, 0), P3(1, 1, 0), P3(0, 1, 0),
+                   P3(0, 0, h0), P3(1, 0, h1), P3(1, 1, h1), P3(0, 1, h0)};
+  soup.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                    {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  Surface surface(soup);
+  validate_surface(surface, "tapered plate");
+  SurfaceBoundary plate(std::move(surface));
+  const double top = h0 * std::sqrt(1 + slope * slope);
+  CHECK(plate.thickness(2) == Approx(top).epsilon(1e-6));  // top {4, 5, 6}
+  CHECK(plate.thickness(3) == Approx(top).epsilon(1e-6));  // top {4, 6, 7}
+  CHECK(plate.thickness(0) == Approx(h0).epsilon(1e-6));   // bottom: its vertex at x = 0
+  CHECK(plate.thickness(1) == Approx(h0).epsilon(1e-6));
+  CHECK(plate.thickness(10) == Approx(1.0).epsilon(1e-6));  // end face x = 0: across to x = 1
+  // The centroid alone misses the taper: top {4, 5, 6}'s centroid is at x = 2/3.
+  const P3 c = (P3(0, 0, h0) + P3(1, 0, h1) + P3(1, 1, h1)) / 3.0;
+  CHECK(plate.thickness_from(2, c, -1) == Approx((h0 + slope * 2.0 / 3.0) * std::sqrt(1 + slope * slope)).epsilon(1e-6));
+  // From the sharp top edge at x = 1 (under 90 degrees) the ray along the end face's inward
+  // normal leaves the solid at once, beside its own triangles: no thickness there.
+  CHECK(std::isinf(plate.thickness_from(7, P3(1, 0, h1), 5)));  // end face {1, 6, 5}
+  // The level field asks for `cells` octants across the thinnest, up to the cap.
+  const double root = plate.root_box().extent()[0];
+  plate.set_global_level(0);
+  plate.set_thickness_level(4, 20);
+  const double wanted = std::log2(root * 4 / top);
+  CHECK(plate.control_level(box(P3(0.9, 0.4, 0.25), P3(0.95, 0.45, 0.32))) == Approx(wanted).epsilon(1e-6));
+  plate.set_thickness_level(4, 5);
+  CHECK(plate.control_level(box(P3(0.9, 0.4, 0.25), P3(0.95, 0.45, 0.32))) == 5.0);
+  plate.set_thickness_level(0, 20);
+  CHECK(plate.control_level(box(P3(0.9, 0.4, 0.25), P3(0.95, 0.45, 0.32))) < wanted - 1);
+}
