@@ -304,27 +304,25 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   b.out.cell.resize(n_int_tets);
   // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
   for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
-    {
-      const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
-      MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
-      const Range& r = *it;
-      std::size_t tri = 0, fan = 0;
-      for (std::size_t k = r.begin; k < r.end; ++k) {
-        const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
-        std::size_t e = tet_start[k];
-        const std::uint8_t level = t.leaf(oc.interior[k]).level;
-        for (std::size_t i = 0; i < n_tris[k]; ++i) {
-          const Tri& q = r.tris[tri + i];
-          if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
-          VertexId* v = m.solid.node.data() + 4 * e;
-          v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
-          m.level[e] = level;
-          b.out.cell[e] = static_cast<std::int32_t>(k);
-          ++e;
-        }
-        tri += n_tris[k];
-        fan += n_fans[k];
+    const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
+    MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
+    const Range& r = *it;
+    std::size_t tri = 0, fan = 0;
+    for (std::size_t k = r.begin; k < r.end; ++k) {
+      const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
+      std::size_t e = tet_start[k];
+      const std::uint8_t level = t.leaf(oc.interior[k]).level;
+      for (std::size_t i = 0; i < n_tris[k]; ++i) {
+        const Tri& q = r.tris[tri + i];
+        if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+        VertexId* v = m.solid.node.data() + 4 * e;
+        v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
+        m.level[e] = level;
+        b.out.cell[e] = static_cast<std::int32_t>(k);
+        ++e;
       }
+      tri += n_tris[k];
+      fan += n_fans[k];
     }
   });
   for (std::size_t e = 0; e <= n_int_tets; ++e) m.solid.offset[e] = static_cast<std::int32_t>(4 * e);
@@ -431,8 +429,8 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     }
     b.cones(tris, centre, bo.cell.level, true, n_interior + static_cast<std::int32_t>(k));
   }
-  // The arrays grew by doubling (up to twice their size); they are kept through smoothing and
-  // edge removal, whose new element arrays make the pipeline's memory peak beside them.
+  // The boundary octants' arrays grew by doubling (up to twice their size); they are kept
+  // through smoothing and edge removal.
   for (auto* v : {&b.out.mesh.solid.offset, &b.out.cell}) v->shrink_to_fit();
   for (auto* v : {&b.out.mesh.level, &b.out.mesh.from_boundary_cell}) v->shrink_to_fit();
   b.out.mesh.solid.type.shrink_to_fit();
