@@ -16,6 +16,7 @@
 #include "core/parallel_ranges.hpp"
 #include "core/point_grid.hpp"
 #include "core/quality.hpp"
+#include "core/sort_short.hpp"
 
 namespace febemesh {
 
@@ -238,12 +239,7 @@ class FacetGroups {
     const auto less = [](const Packed& x, const Packed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; };
     for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
       const auto first = packed_.begin() + start_[b], last = packed_.begin() + start_[b + 1];
-      if (last - first > 32) {
-        std::stable_sort(first, last, less);
-      } else {
-        for (auto i = first + (first != last); i < last; ++i)
-          for (auto j = i; j != first && less(*j, *(j - 1)); --j) std::iter_swap(j, j - 1);
-      }
+      stable_sort_short(first, last, less);
       for (auto i = first; i < last; ++i) n_groups_ += i == first || less(*(i - 1), *i);
     }
   }
