@@ -238,19 +238,20 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
   // 1.77: splitting a face also splits the pyramid beside it, which hid a 1.77 deg cone.
   const bool dihedral_rule = opt.min_dihedral_deg > 0;
   const auto min_dihedral = [](ElemType type, std::span<const P3> ep) { return element_quality<3>(type, ep).min_angle_deg; };
+  // Every tetrahedron's smallest angle once: the quads' and the hexes' cones read it.
+  std::vector<double> tet_min(m.solid.size());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    tet_min[e] = min_dihedral(ElemType::Tet4, element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, pts).span());
+    st.tets_min_dihedral_deg = std::min(st.tets_min_dihedral_deg, tet_min[e]);
+  }
   const auto cones_min_dihedral = [&](const auto& cones) {
     double lo = 180.0;
-    for (std::size_t e : cones)
-      lo = std::min(lo, min_dihedral(ElemType::Tet4, element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, pts).span()));
+    for (std::size_t e : cones) lo = std::min(lo, tet_min[e]);
     return lo;
   };
   const auto keeps_dihedral = [&](double merged, double cones) {
     return !dihedral_rule || merged >= std::min(opt.min_dihedral_deg, cones);
   };
-  for (std::size_t e = 0; e < m.solid.size(); ++e)
-    st.tets_min_dihedral_deg = std::min(
-        st.tets_min_dihedral_deg,
-        min_dihedral(ElemType::Tet4, element_points<3>(m.solid, ElemId{static_cast<std::int32_t>(e)}, pts).span()));
   for (CellInfo& ci : cells) {
     for (QuadFace& q : ci.quads) {
       const auto ep = points_of(pts, {q.ring[0], q.ring[3], q.ring[2], q.ring[1], ci.apex});
