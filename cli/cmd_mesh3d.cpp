@@ -173,6 +173,7 @@ int run(const std::vector<std::string>& argv) {
                     {"facing_projection", r.facing_projection},
                     {"thickness_refined", r.thickness_refined},
                     {"thickness_after_refusal", r.thickness_after_refusal},
+                    {"thin_parts_coarse", r.thin_parts_coarse},
                     {"level_raised", r.level_raised}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},
@@ -259,9 +260,13 @@ int run(const std::vector<std::string>& argv) {
   if (fid.volume_rel_error > 0.05) {
     std::ostringstream w;
     w.precision(3);
-    w << input << ": the mesh's volume differs from the surface's by " << 100.0 * fid.volume_rel_error
-      << "% (parts of the solid are not meshed: thin parts or dropped islands; a higher --level may"
-      << " resolve them)";
+    w << input << ": the mesh's volume differs from the surface's by " << 100.0 * fid.volume_rel_error;
+    if (r.thin_parts_coarse)
+      w << "% (parts thinner than the octants are not meshed: every try that refined them was refused,"
+        << " and this one does not refine them)";
+    else
+      w << "% (parts of the solid are not meshed: thin parts or dropped islands; a higher --level may"
+        << " resolve them)";
     warnings.push_back(w.str());
     std::cerr << "febemesh mesh3d: warning: " << w.str() << "\n";
   }

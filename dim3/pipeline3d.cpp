@@ -505,18 +505,38 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 }  // namespace
 
-/// mesh3d_raised's refusal `e` (after `effort`): once more with the thickness level when part of
-/// the solid is thin (Options3d::refused_thickness_cells); when that is refused too, `e` again
-/// (the same type), with the second refusal's reason.
+/// One try after every other was refused: mesh3d_facing with `o` within its own work bound of
+/// o.effort first trees. The mesh (its n_octants_built counting `effort` too), or the refusal's
+/// reason in `why`.
+std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o, const Effort& effort,
+                                          std::string& why, const Progress3& progress) {
+  Effort own;
+  try {
+    Result3d t = mesh3d_facing(s, o, own, progress);
+    t.n_octants_built = effort.used + own.used;
+    return t;
+  } catch (const GeometryError& f) {
+    why = f.what();
+  } catch (const LimitError& f) {
+    why = f.what();
+  }
+  return std::nullopt;
+}
+
+/// mesh3d_raised's refusal `e` (after `effort`): when part of the solid is thin, once more with
+/// the thickness level (Options3d::refused_thickness_cells), and when that is refused too, once
+/// more with the thin parts coarse (Options3d::coarse_thin_after_refusal); when every one is
+/// refused, `e` again (the same type), with their reasons.
 template <class E>
-Result3d thickness_after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& effort, const E& e,
-                                 const Progress3& progress) {
+Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& effort, const E& e,
+                       const Progress3& progress) {
   const double cells = opt.refused_thickness_cells;
   if (!(cells > 0) || opt.thickness_cells > 0) throw e;
   // Only where the thickness level passes the feature level (level + 1), else the first tree is
   // the one refused already.
   const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
   if (!(s.thin_share(cells * h_feature) > 0)) throw e;
+  std::string reasons = e.what(), why;
   Options3d thick = opt;
   thick.thickness_cells = cells;
   thick.buffer = 0.0;  // its one-octant slabs in thin parts project through them (thin retry)
@@ -526,20 +546,31 @@ Result3d thickness_after_refusal(SurfaceBoundary& s, const Options3d& opt, const
   if (progress)
     progress(std::string("refused (") + e.what() + "): once more with " + std::to_string(cells) +
              " octants across the thin parts, without the buffer rule");
-  Effort thick_effort;
-  std::string why;
-  try {
-    Result3d t = mesh3d_facing(s, thick, thick_effort, progress);
-    t.n_octants_built = effort.used + thick_effort.used;
-    t.thickness_after_refusal = true;
-    return t;
-  } catch (const GeometryError& f) {
-    why = f.what();
-  } catch (const LimitError& f) {
-    why = f.what();
+  if (std::optional<Result3d> t = try_after_refusal(s, thick, effort, why, progress)) {
+    t->thickness_after_refusal = true;
+    return std::move(*t);
   }
   s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
-  throw E(std::string(e.what()) + "; with " + std::to_string(cells) + " octants across the thin parts: " + why);
+  reasons += "; with " + std::to_string(cells) + " octants across the thin parts: " + why;
+  if (!opt.coarse_thin_after_refusal) throw E(reasons);
+  Options3d coarse = opt;
+  coarse.island_refinements = 0;
+  coarse.thin_cells = 0.0;
+  coarse.raise_levels = 0;
+  coarse.effort = std::min(opt.effort, opt.thin_retry_effort);
+  coarse.min_effort_octants = 0;
+  const double feature_extra = s.feature_extra_levels();
+  s.set_feature_extra_levels(0.0);
+  if (progress)
+    progress("refused (" + why + "): once more without the feature level and the thin parts' refinements" +
+             " (parts thinner than the octants are not meshed)");
+  std::optional<Result3d> c = try_after_refusal(s, coarse, effort, why, progress);
+  s.set_feature_extra_levels(feature_extra);
+  if (c) {
+    c->thin_parts_coarse = true;
+    return std::move(*c);
+  }
+  throw E(reasons + "; without the feature level: " + why);
 }
 
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
@@ -548,9 +579,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   try {
     r = mesh3d_raised(s, opt, effort, progress);
   } catch (const GeometryError& e) {
-    return thickness_after_refusal(s, opt, effort, e, progress);
+    return after_refusal(s, opt, effort, e, progress);
   } catch (const LimitError& e) {
-    return thickness_after_refusal(s, opt, effort, e, progress);
+    return after_refusal(s, opt, effort, e, progress);
   }
   r.n_octants_built = effort.used;
   Options3d ran = opt;  // the thickness retry below is at the level the mesh was made at

@@ -124,6 +124,16 @@ struct Options3d {
   /// with 4 octants across, up to level 8, the first try is valid without a repair (diagnose3d
   /// --single --buffer 0: 3,186,715 tets, 11.05 deg, 0.16% volume error, 32 s CPU, 737 MB).
   double refused_thickness_cells = 4.0;
+  /// When that try is refused too (or not run), once more without what refines the thin parts
+  /// to 1-3 octants across: no feature level (SurfaceOptions::feature_extra_levels 0: on a
+  /// coarse tessellation the triangles touching a feature edge cover whole thin sheets), no
+  /// island refinements and no thin-surface refinement, within its own work bound of
+  /// thin_retry_effort (Result3d::thin_parts_coarse). Parts thinner than the octants are then
+  /// not meshed (the volume error and a warning say how much). Measured (rotor L6, whose blades
+  /// are 0.02 thick, 1.2 level-6 octants: refused by every other try after 1389 s CPU; this try
+  /// alone, diagnose3d --feature-extra 0 --thin-cells 0 --island-refinements 0 --pipeline):
+  /// valid, 162,253 tets, 20.01 deg, 30.36% of the volume (the blades) lost.
+  bool coarse_thin_after_refusal = true;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   /// The work bound, so that no input runs for ever: the octants of every tree the boundary
@@ -164,6 +174,7 @@ struct Result3d {
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
   bool thickness_after_refusal = false;  ///< refused; this run has Options3d::refused_thickness_cells' thickness level
+  bool thin_parts_coarse = false;    ///< refused; this run has Options3d::coarse_thin_after_refusal's rules
   int level_raised = 0;              ///< refused at Options3d::level; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;

@@ -71,6 +71,9 @@ class SurfaceBoundary final : public Boundary<3> {
 
   void set_global_level(double level) { options_.global_level = level; }
   void set_max_level(double level) { options_.max_level = level; }
+  /// The feature level's levels above the global one (SurfaceOptions::feature_extra_levels).
+  void set_feature_extra_levels(double levels) { options_.feature_extra_levels = levels; }
+  double feature_extra_levels() const { return options_.feature_extra_levels; }
   /// The thickness level's cells across (0 = off) and its cap; computes the thicknesses on
   /// first use (not thread-safe: call before the level field is read).
   void set_thickness_level(double cells, double max_level);

@@ -124,6 +124,7 @@ TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part"
   CHECK(with.find("over its work bound") != std::string::npos);
   CHECK(with.find("octants across the thin parts: the boundary octants could not be built within the work bound") !=
         std::string::npos);
+  CHECK(with.find("; without the feature level: ") != std::string::npos);  // coarse_thin_after_refusal
   INFO(without);
   CHECK(without.find("over its work bound") != std::string::npos);
   CHECK(without.find("octants across the thin parts") == std::string::npos);
@@ -131,6 +132,67 @@ TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part"
   soup.vertices = {P3(0, 0, 0), P3(1, 0, 0), P3(1, 1, 0), P3(0, 1, 0),
                    P3(0, 0, 1), P3(1, 0, 1), P3(1, 1, 1), P3(0, 1, 1)};
   CHECK(refusal(0.1).find("octants across the thin parts") == std::string::npos);
+}
+
+// Options3d::coarse_thin_after_refusal: when the thickness try is refused too, one more try
+// without the feature level and the thin parts' refinements, which leaves out parts thinner than
+// the octants. A block with a fin 0.02 thick (rotor's blades) at level 4: every triangle touches
+// a feature edge, so the feature level refines the whole surface to level 5 and the thickness
+// level refines the fin further; a cap on the tree's leaves between those trees and the uniform
+// level-4 one refuses the tries that refine, and the coarse try meshes the block without the fin.
+TEST_CASE("mesh3d leaves out the thin parts after every refining try is refused", "[pipeline3d][thickness]") {
+  // The profile in the xz plane (a square with a thin fin on its right side), extruded along y.
+  const std::array<std::array<double, 2>, 8> xz{{{0, 0}, {0.6, 0}, {0.6, 0.29}, {1, 0.29}, {1, 0.31}, {0.6, 0.31},
+                                                 {0.6, 0.6}, {0, 0.6}}};
+  TriangleSoup soup;
+  for (double y : {0.0, 0.6})
+    for (const auto& p : xz) soup.vertices.push_back(P3(p[0], y, p[1]));
+  // The profile's triangles (counter-clockwise in x, z), at y = 0.6 (their normal +y) and at y = 0
+  // reversed; the sides between.
+  const std::array<std::array<int, 3>, 6> cap{{{0, 1, 2}, {0, 2, 5}, {0, 5, 6}, {0, 6, 7}, {2, 3, 4}, {2, 4, 5}}};
+  for (const auto& t : cap) {
+    soup.triangles.push_back({t[0], t[2], t[1]});
+    soup.triangles.push_back({8 + t[0], 8 + t[1], 8 + t[2]});
+  }
+  for (int i = 0; i < 8; ++i) {
+    const int j = (i + 1) % 8;
+    soup.triangles.push_back({i, j, 8 + j});
+    soup.triangles.push_back({i, 8 + j, 8 + i});
+  }
+  const auto run = [&](bool coarse, Result3d& r) {
+    Surface surface(soup);
+    validate_surface(surface, "block with a fin");
+    SurfaceBoundary s(std::move(surface));
+    Options3d opt;
+    opt.level = 4;
+    opt.n_threads = 1;
+    opt.raise_levels = 0;
+    opt.max_cells = 3 * 4096;  // the uniform level-4 tree has 8^4 leaves
+    opt.coarse_thin_after_refusal = coarse;
+    std::string what;
+    try {
+      r = mesh3d(s, opt);
+      const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+      INFO(v.summary());
+      CHECK(v.valid);
+      const double fin = 0.4 * 0.02 * 0.6, block = 0.6 * 0.6 * 0.6;
+      // The block, without the fin (at level 4 its edges are cut a little: 0.2076 of 0.216).
+      const double v_mesh = solid_measure<3>(r.fe.mesh);
+      CHECK(v_mesh > 0.95 * block);
+      CHECK(v_mesh < block + 0.5 * fin);
+      CHECK(s.volume() == Approx(block + fin));
+    } catch (const LimitError& e) {
+      what = e.what();
+    }
+    return what;
+  };
+  Result3d with, without;
+  const std::string refused = run(false, without);
+  INFO(refused);
+  CHECK(refused.find("octants across the thin parts") != std::string::npos);
+  CHECK(run(true, with).empty());
+  CHECK(with.thin_parts_coarse);
+  CHECK_FALSE(with.thickness_after_refusal);
 }
 
 // Options3d::faceted_free_ends: the same sphere's 30-degree creases are facets, most of them
