@@ -8,6 +8,7 @@
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/parallel_ranges.hpp"
 
 namespace febemesh::dim3 {
@@ -296,38 +297,6 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   }
   const std::size_t n_int_tets = tet_start[n_int];
   Mesh<3>& m = b.out.mesh;
-  m.solid.type.assign(n_int_tets, ElemType::Tet4);
-  m.solid.offset.resize(n_int_tets + 1);
-  m.solid.node.resize(4 * n_int_tets);
-  m.level.resize(n_int_tets);
-  m.from_boundary_cell.assign(n_int_tets, 0);
-  b.out.cell.resize(n_int_tets);
-  // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
-  for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
-    const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
-    MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
-    const Range& r = *it;
-    std::size_t tri = 0, fan = 0;
-    for (std::size_t k = r.begin; k < r.end; ++k) {
-      const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
-      std::size_t e = tet_start[k];
-      const std::uint8_t level = t.leaf(oc.interior[k]).level;
-      for (std::size_t i = 0; i < n_tris[k]; ++i) {
-        const Tri& q = r.tris[tri + i];
-        if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
-        VertexId* v = m.solid.node.data() + 4 * e;
-        v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
-        m.level[e] = level;
-        b.out.cell[e] = static_cast<std::int32_t>(k);
-        ++e;
-      }
-      tri += n_tris[k];
-      fan += n_fans[k];
-    }
-  });
-  for (std::size_t e = 0; e <= n_int_tets; ++e) m.solid.offset[e] = static_cast<std::int32_t>(4 * e);
-  ranges.clear();
-  ranges.shrink_to_fit();
 
   // Boundary octants.
   const std::int32_t n_interior = static_cast<std::int32_t>(oc.interior.size());
@@ -429,12 +398,66 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     }
     b.cones(tris, centre, bo.cell.level, true, n_interior + static_cast<std::int32_t>(k));
   }
-  // The boundary octants' arrays grew by doubling (up to twice their size); they are kept
-  // through smoothing and edge removal.
-  for (auto* v : {&b.out.mesh.solid.offset, &b.out.cell}) v->shrink_to_fit();
-  for (auto* v : {&b.out.mesh.level, &b.out.mesh.from_boundary_cell}) v->shrink_to_fit();
-  b.out.mesh.solid.type.shrink_to_fit();
-  b.out.mesh.solid.node.shrink_to_fit();
+  // The boundary octants' tetrahedra were built first (nodes in the same order: pass 3 adds
+  // none); they go after the interior ones, into arrays allocated once at their final size.
+  // Appending them to the interior ones instead grew every array by doubling and shrank it
+  // again: three fresh copies of each, and their page faults.
+  Elements bnd = std::move(m.solid);
+  std::vector<std::uint8_t> bnd_level = std::move(m.level), bnd_from = std::move(m.from_boundary_cell);
+  std::vector<std::int32_t> bnd_cell = std::move(b.out.cell);
+  const std::size_t n_all_tets = n_int_tets + bnd.size();
+  m.solid = Elements{};
+  reserve_huge(m.solid.type, n_all_tets);
+  m.solid.type.assign(n_int_tets, ElemType::Tet4);
+  m.solid.type.insert(m.solid.type.end(), bnd.type.begin(), bnd.type.end());
+  reserve_huge(m.solid.offset, n_all_tets + 1);
+  m.solid.offset.resize(n_all_tets + 1);
+  reserve_huge(m.solid.node, 4 * n_all_tets);
+  m.solid.node.resize(4 * n_int_tets);
+  m.solid.node.insert(m.solid.node.end(), bnd.node.begin(), bnd.node.end());
+  reserve_huge(m.level, n_all_tets);
+  m.level.resize(n_int_tets);
+  m.level.insert(m.level.end(), bnd_level.begin(), bnd_level.end());
+  reserve_huge(m.from_boundary_cell, n_all_tets);
+  m.from_boundary_cell.assign(n_int_tets, 0);
+  m.from_boundary_cell.insert(m.from_boundary_cell.end(), bnd_from.begin(), bnd_from.end());
+  reserve_huge(b.out.cell, n_all_tets);
+  b.out.cell.resize(n_int_tets);
+  b.out.cell.insert(b.out.cell.end(), bnd_cell.begin(), bnd_cell.end());
+  for (std::size_t e = 0; e < bnd.size(); ++e)
+    MESH_ASSERT(bnd.type[e] == ElemType::Tet4 && bnd.offset[e] == static_cast<std::int32_t>(4 * e),
+                "tetrahedralize: a boundary octant's element is not a tetrahedron");
+  bnd = Elements{};
+  bnd_level = {}, bnd_from = {}, bnd_cell = {};
+  // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
+  for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
+    const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
+    MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
+    const Range& r = *it;
+    std::size_t tri = 0, fan = 0;
+    for (std::size_t k = r.begin; k < r.end; ++k) {
+      const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
+      std::size_t e = tet_start[k];
+      const std::uint8_t level = t.leaf(oc.interior[k]).level;
+      for (std::size_t i = 0; i < n_tris[k]; ++i) {
+        const Tri& q = r.tris[tri + i];
+        if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+        VertexId* v = m.solid.node.data() + 4 * e;
+        v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
+        m.level[e] = level;
+        b.out.cell[e] = static_cast<std::int32_t>(k);
+        ++e;
+      }
+      tri += n_tris[k];
+      fan += n_fans[k];
+    }
+  });
+  for (std::size_t e = 0; e <= n_all_tets; ++e) m.solid.offset[e] = static_cast<std::int32_t>(4 * e);
+  ranges.clear();
+  ranges.shrink_to_fit();
+
+  // The node arrays grew by doubling (up to twice their size); they are kept through smoothing
+  // and edge removal.
   b.out.mesh.points.shrink_to_fit();
   b.out.where.shrink_to_fit();
   return std::move(b.out);
