@@ -8,6 +8,7 @@
 #include "core/local_repair.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
+#include "dim2/heap_policy.hpp"
 #include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
 #include "dim2/optimise_angles.hpp"
@@ -46,6 +47,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   auto say = [&](const std::string& s) {
     if (progress) progress(s);
   };
+  keep_freed_arrays_in_heap();
   Result2d r;
   StageTimer clock(r.times);
   RefineOptions ro;
