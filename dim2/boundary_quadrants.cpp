@@ -204,6 +204,13 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   QuadrantComplexResult res;
   QuadrantComplex& qc = res.complex;
   const LatticeNodes<2> nodes = lattice_nodes(t, &in, HangingFlags::Skipped);
+  const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
+  const FreeEdges& facets = edges ? *edges : computed;
+  // The nodes' arrays at their final size (the lattice nodes, then at most a projection a free
+  // edge and the curve's corners), the boundary quadrants' too (one a free edge): grown by
+  // doubling, they were copied and their fresh pages faulted in again (perf, flange 1e6).
+  qc.reserve_nodes(nodes.points.size(), facets.size() + curve.corners().size());
+  qc.boundary.reserve(facets.size());
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
   std::vector<std::uint64_t> node_keys(nodes.points.size());
@@ -240,8 +247,6 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   }
 
   // Free edges and their chains.
-  const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
-  const FreeEdges& facets = edges ? *edges : computed;
   res.stats.n_free_edges = facets.size();
   std::vector<std::int32_t> next_facet(nodes.points.size(), -1);
   std::vector<std::array<std::int32_t, 2>> ends(facets.size());

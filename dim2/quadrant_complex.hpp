@@ -80,6 +80,13 @@ struct QuadrantComplex {
   BoundaryLocation& where(std::int32_t i) { return where_[index_of(i)]; }
   const BoundaryLocation& where(std::int32_t i) const { return where_[index_of(i)]; }
 
+  /// Room for n_lattice lattice nodes and n_boundary boundary nodes (add_node's arrays).
+  void reserve_nodes(std::size_t n_lattice, std::size_t n_boundary) {
+    points.reserve(n_lattice + n_boundary);
+    kind.reserve(n_lattice + n_boundary);
+    where_.reserve(n_boundary);
+  }
+
   /// Lattice nodes (Interior, Chain) first, then Boundary nodes: only these have a location
   /// (32 bytes a node for every node was ~16 bytes an element at the run's memory peak).
   std::int32_t add_node(const Point<2>& p, NodeKind k, const BoundaryLocation& w = {}) {
