@@ -198,8 +198,12 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   // it instead of re-evaluating the incident elements before each move (same values). Its two
   // parts in two arrays, 9 bytes an element: a pair<bool, double> (16) made this the 2D run's
   // heap peak (flange level 9, massif).
-  std::vector<double> scaled(mesh.solid.size());
-  std::vector<std::uint8_t> valid(mesh.solid.size());
+  std::vector<double> scaled;
+  std::vector<std::uint8_t> valid;
+  reserve_huge(scaled, mesh.solid.size());
+  reserve_huge(valid, mesh.solid.size());
+  scaled.resize(mesh.solid.size());
+  valid.resize(mesh.solid.size());
   auto set_state = [&](std::int32_t e, const std::pair<bool, double>& st) {
     valid[static_cast<std::size_t>(e)] = st.first ? 1 : 0;
     scaled[static_cast<std::size_t>(e)] = st.second;

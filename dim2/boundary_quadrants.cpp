@@ -10,6 +10,7 @@
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
 #include "core/free_facets.hpp"
+#include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
 
 namespace febemesh::dim2 {
@@ -213,8 +214,9 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   qc.boundary.reserve(facets.size());
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
-  std::vector<std::uint64_t> node_keys(nodes.points.size());
-  for (std::size_t k = 0; k < nodes.points.size(); ++k) node_keys[k] = point_key<2>(nodes.points[k]);
+  std::vector<std::uint64_t> node_keys;
+  reserve_huge(node_keys, nodes.points.size());
+  for (const LP& p : nodes.points) node_keys.push_back(point_key<2>(p));
   auto find_node = [&](const LP& p) {
     const std::uint64_t key = point_key<2>(p);
     const auto it = std::lower_bound(node_keys.begin(), node_keys.end(), key);
@@ -225,7 +227,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // own answer (leaf_corners); a mid-edge node is searched by galloping from the same edge's
   // answer for the previous quadrant (consecutive leaves are near in Morton order): the index
   // a full binary search gives, in a few probes of nearby keys.
-  qc.interior.reserve(static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
+  reserve_huge(qc.interior, static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
   std::array<std::size_t, 4> near{};
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!in[i]) continue;

@@ -10,6 +10,7 @@
 #include "core/boundary.hpp"
 #include "core/box.hpp"
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace febemesh::dim2 {
 
@@ -80,11 +81,12 @@ struct QuadrantComplex {
   BoundaryLocation& where(std::int32_t i) { return where_[index_of(i)]; }
   const BoundaryLocation& where(std::int32_t i) const { return where_[index_of(i)]; }
 
-  /// Room for n_lattice lattice nodes and n_boundary boundary nodes (add_node's arrays).
+  /// Room for n_lattice lattice nodes and n_boundary boundary nodes (add_node's arrays), on
+  /// huge pages where large.
   void reserve_nodes(std::size_t n_lattice, std::size_t n_boundary) {
-    points.reserve(n_lattice + n_boundary);
-    kind.reserve(n_lattice + n_boundary);
-    where_.reserve(n_boundary);
+    reserve_huge(points, n_lattice + n_boundary);
+    reserve_huge(kind, n_lattice + n_boundary);
+    reserve_huge(where_, n_boundary);
   }
 
   /// Lattice nodes (Interior, Chain) first, then Boundary nodes: only these have a location
