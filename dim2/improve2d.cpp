@@ -248,14 +248,15 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m) {
   }
   for (std::size_t v = 0; v + 1 < out.first.size(); ++v) out.first[v + 1] += out.first[v];
   std::vector<std::int32_t> nbr(static_cast<std::size_t>(out.first.back()));
-  {
-    std::vector<std::int32_t> fill(out.first.begin(), out.first.end() - 1);
-    for (std::size_t e = 0; e < m.interface.size(); ++e) {
-      const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
-      nbr[fill[v[0].v]++] = v[1].v;
-      nbr[fill[v[1].v]++] = v[0].v;
-    }
+  // Filled with first[v] as v's cursor, which ends at the next node's start; then moved back
+  // one place (no copy of the n + 1 starts as cursors).
+  for (std::size_t e = 0; e < m.interface.size(); ++e) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    nbr[out.first[v[0].v]++] = v[1].v;
+    nbr[out.first[v[1].v]++] = v[0].v;
   }
+  for (std::size_t v = out.first.size() - 1; v > 0; --v) out.first[v] = out.first[v - 1];
+  out.first[0] = 0;
   // Sorted and deduplicated per node, compacted in place.
   out.nbr.reserve(nbr.size());
   for (std::size_t v = 0; v + 1 < out.first.size(); ++v) {
