@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
@@ -124,9 +125,10 @@ struct Chain {
 
 }  // namespace
 
-std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges, const LeafKeys<2>* given_keys) {
   std::size_t removed = 0;
-  const LeafKeys<2> keys(t);
+  std::optional<LeafKeys<2>> own_keys;
+  const LeafKeys<2>& keys = given_keys ? *given_keys : own_keys.emplace(t);
   FreeEdges facets = edges ? std::move(*edges) : free_facets(t, keys, in);
   std::vector<std::size_t> dropped;  // since `facets` was free_facets(t, in)
   for (int pass = 0; pass < 64; ++pass) {
@@ -156,13 +158,14 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
 }
 
 std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
-                         FreeEdges* edges) {
+                         FreeEdges* edges, const LeafKeys<2>* given_keys) {
   if (fraction <= 0) {
-    if (edges) *edges = free_facets(t, in);
+    if (edges) *edges = given_keys ? free_facets(t, *given_keys, in) : free_facets(t, in);
     return 0;
   }
+  std::optional<LeafKeys<2>> own_keys;
+  const LeafKeys<2>& keys = given_keys ? *given_keys : own_keys.emplace(t);
   std::size_t removed = 0;
-  const LeafKeys<2> keys(t);
   FreeEdges facets = free_facets(t, keys, in);
   // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
   // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
