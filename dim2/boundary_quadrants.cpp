@@ -4,12 +4,14 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <unordered_map>
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
 #include "core/free_facets.hpp"
+#include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
 
 namespace febemesh::dim2 {
@@ -123,9 +125,10 @@ struct Chain {
 
 }  // namespace
 
-std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges, const LeafKeys<2>* given_keys) {
   std::size_t removed = 0;
-  const LeafKeys<2> keys(t);
+  std::optional<LeafKeys<2>> own_keys;
+  const LeafKeys<2>& keys = given_keys ? *given_keys : own_keys.emplace(t);
   FreeEdges facets = edges ? std::move(*edges) : free_facets(t, keys, in);
   std::vector<std::size_t> dropped;  // since `facets` was free_facets(t, in)
   for (int pass = 0; pass < 64; ++pass) {
@@ -155,13 +158,14 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges) {
 }
 
 std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
-                         FreeEdges* edges) {
+                         FreeEdges* edges, const LeafKeys<2>* given_keys) {
   if (fraction <= 0) {
-    if (edges) *edges = free_facets(t, in);
+    if (edges) *edges = given_keys ? free_facets(t, *given_keys, in) : free_facets(t, in);
     return 0;
   }
+  std::optional<LeafKeys<2>> own_keys;
+  const LeafKeys<2>& keys = given_keys ? *given_keys : own_keys.emplace(t);
   std::size_t removed = 0;
-  const LeafKeys<2> keys(t);
   FreeEdges facets = free_facets(t, keys, in);
   // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
   // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
@@ -204,10 +208,18 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   QuadrantComplexResult res;
   QuadrantComplex& qc = res.complex;
   const LatticeNodes<2> nodes = lattice_nodes(t, &in, HangingFlags::Skipped);
+  const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
+  const FreeEdges& facets = edges ? *edges : computed;
+  // The nodes' arrays at their final size (the lattice nodes, then at most a projection a free
+  // edge and the curve's corners), the boundary quadrants' too (one a free edge): grown by
+  // doubling, they were copied and their fresh pages faulted in again (perf, flange 1e6).
+  qc.reserve_nodes(nodes.points.size(), facets.size() + curve.corners().size());
+  qc.boundary.reserve(facets.size());
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
-  std::vector<std::uint64_t> node_keys(nodes.points.size());
-  for (std::size_t k = 0; k < nodes.points.size(); ++k) node_keys[k] = point_key<2>(nodes.points[k]);
+  std::vector<std::uint64_t> node_keys;
+  reserve_huge(node_keys, nodes.points.size());
+  for (const LP& p : nodes.points) node_keys.push_back(point_key<2>(p));
   auto find_node = [&](const LP& p) {
     const std::uint64_t key = point_key<2>(p);
     const auto it = std::lower_bound(node_keys.begin(), node_keys.end(), key);
@@ -218,7 +230,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // own answer (leaf_corners); a mid-edge node is searched by galloping from the same edge's
   // answer for the previous quadrant (consecutive leaves are near in Morton order): the index
   // a full binary search gives, in a few probes of nearby keys.
-  qc.interior.reserve(static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
+  reserve_huge(qc.interior, static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
   std::array<std::size_t, 4> near{};
   for (std::size_t i = 0; i < t.n_leaves(); ++i) {
     if (!in[i]) continue;
@@ -240,8 +252,6 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   }
 
   // Free edges and their chains.
-  const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
-  const FreeEdges& facets = edges ? *edges : computed;
   res.stats.n_free_edges = facets.size();
   std::vector<std::int32_t> next_facet(nodes.points.size(), -1);
   std::vector<std::array<std::int32_t, 2>> ends(facets.size());

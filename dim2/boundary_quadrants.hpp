@@ -56,13 +56,14 @@ using FreeEdges = std::vector<FreeFacet<2>>;
 /// Drop interior quadrants so that no two of them meet only at a vertex (a pinch of the
 /// interior region, which would make the boundary chains non-manifold). Returns how many.
 /// `edges`, when given, holds free_facets(t, in) on entry and holds it for the new `in` on return.
-std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges = nullptr);
+/// `keys`, when given, is LeafKeys<2>(t) (else built here; apply_buffer needs the same).
+std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges = nullptr, const LeafKeys<2>* keys = nullptr);
 
 /// Drop interior quadrants nearer to the curve than `fraction` of their size (the buffer rule
 /// against very thin boundary quadrants). Returns how many. `edges`, when given, receives
-/// free_facets(t, in) for the new `in`.
+/// free_facets(t, in) for the new `in`. `keys` as for remove_pinches.
 std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
-                         FreeEdges* edges = nullptr);
+                         FreeEdges* edges = nullptr, const LeafKeys<2>* keys = nullptr);
 
 struct BoundaryQuadrantOptions {
   int max_normals = 4;               ///< local minima tried before walking along the curve

@@ -172,15 +172,26 @@ namespace {
 class LiveIncidence {
  public:
   explicit LiveIncidence(const Mesh<2>& m) { rebuild(m); }
+  /// The lists add() would make of the elements in increasing order (each list ascending, then
+  /// its spare slots), filled from the back: first_[v] starts at the end of v's uses and steps
+  /// down to its start, one store a use instead of add's search for the first free slot.
   void rebuild(const Mesh<2>& m) {
-    reserve_huge(first_, m.points.size() + 1);
-    first_.assign(m.points.size() + 1, 0);
-    for (const VertexId v : m.solid.node) ++first_[static_cast<std::size_t>(v.v) + 1];
-    for (std::size_t v = 0; v + 1 < first_.size(); ++v) first_[v + 1] += first_[v] + spare;
-    reserve_huge(elem_, static_cast<std::size_t>(first_.back()));
-    elem_.assign(static_cast<std::size_t>(first_.back()), -1);
-    for (std::size_t e = 0; e < m.solid.size(); ++e)
-      for (std::int32_t k = m.solid.offset[e]; k < m.solid.offset[e + 1]; ++k) add(m.solid.node[k].v, static_cast<std::int32_t>(e));
+    const std::size_t n = m.points.size();
+    reserve_huge(first_, n + 1);
+    first_.assign(n + 1, 0);
+    for (const VertexId v : m.solid.node) ++first_[static_cast<std::size_t>(v.v)];
+    std::int32_t start = 0;
+    for (std::size_t v = 0; v < n; ++v) {
+      const std::int32_t uses = first_[v];
+      first_[v] = start + uses;
+      start += uses + spare;
+    }
+    first_[n] = start;
+    reserve_huge(elem_, static_cast<std::size_t>(start));
+    elem_.assign(static_cast<std::size_t>(start), -1);
+    for (std::size_t e = m.solid.size(); e-- > 0;)
+      for (std::int32_t k = m.solid.offset[e + 1]; k-- > m.solid.offset[e];)
+        elem_[static_cast<std::size_t>(--first_[static_cast<std::size_t>(m.solid.node[k].v)])] = static_cast<std::int32_t>(e);
   }
   /// A list is a prefix of its slots (add fills the first free one, remove moves the last in):
   /// its end is found from the back, where most lists have their spare slots free.
@@ -237,14 +248,15 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m) {
   }
   for (std::size_t v = 0; v + 1 < out.first.size(); ++v) out.first[v + 1] += out.first[v];
   std::vector<std::int32_t> nbr(static_cast<std::size_t>(out.first.back()));
-  {
-    std::vector<std::int32_t> fill(out.first.begin(), out.first.end() - 1);
-    for (std::size_t e = 0; e < m.interface.size(); ++e) {
-      const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
-      nbr[fill[v[0].v]++] = v[1].v;
-      nbr[fill[v[1].v]++] = v[0].v;
-    }
+  // Filled with first[v] as v's cursor, which ends at the next node's start; then moved back
+  // one place (no copy of the n + 1 starts as cursors).
+  for (std::size_t e = 0; e < m.interface.size(); ++e) {
+    const VertexId* v = m.interface.nodes(ElemId{static_cast<std::int32_t>(e)});
+    nbr[out.first[v[0].v]++] = v[1].v;
+    nbr[out.first[v[1].v]++] = v[0].v;
   }
+  for (std::size_t v = out.first.size() - 1; v > 0; --v) out.first[v] = out.first[v - 1];
+  out.first[0] = 0;
   // Sorted and deduplicated per node, compacted in place.
   out.nbr.reserve(nbr.size());
   for (std::size_t v = 0; v + 1 < out.first.size(); ++v) {
@@ -441,8 +453,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     // ---- guarded smoothing on the smallest angle ----
     for (std::size_t v = 0; v < n_nodes; ++v) {
       const bool sliding = locked[v] == 2 && slide;
+      if (settled[v] || (locked[v] && !sliding)) continue;
       const auto elems = incident.of(static_cast<std::int32_t>(v));
-      if ((locked[v] && !sliding) || elems.empty() || settled[v]) continue;
+      if (elems.empty()) continue;
       if (sliding) {
         nb.assign(curve_neighbours.of(v).begin(), curve_neighbours.of(v).end());
       } else {

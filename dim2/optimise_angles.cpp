@@ -6,6 +6,7 @@
 #include <limits>
 #include <span>
 
+#include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 
 namespace febemesh::dim2 {
@@ -65,13 +66,17 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   const std::size_t n_nodes = m.points.size(), n_elems = m.solid.size();
 
   // Node -> incident elements (CSR) and node -> edge neighbours (CSR, sorted, unique).
-  std::vector<std::int32_t> first(n_nodes + 1, 0);
+  std::vector<std::int32_t> first;
+  reserve_huge(first, n_nodes + 1);
+  first.assign(n_nodes + 1, 0);
   for (std::size_t e = 0; e < n_elems; ++e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     for (int k = 0; k < m.solid.n_nodes_of(id); ++k) ++first[m.solid.nodes(id)[k].v + 1];
   }
   for (std::size_t v = 0; v < n_nodes; ++v) first[v + 1] += first[v];
-  std::vector<std::int32_t> incident(first.back());
+  std::vector<std::int32_t> incident;
+  reserve_huge(incident, static_cast<std::size_t>(first.back()));
+  incident.resize(static_cast<std::size_t>(first.back()));
   {
     std::vector<std::int32_t> fill(first.begin(), first.end() - 1);  // (freed here: this is the run's memory peak)
     for (std::size_t e = 0; e < n_elems; ++e) {
@@ -114,7 +119,9 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // above the target and are skipped on these cached values (the same numbers). An element
   // clearly above the target (clearly_above: no atan2) holds NaN until a node of it moves: it
   // cannot be the worst of a node below the target, nor of the mesh while one is below.
-  std::vector<double> q_elem(n_elems);
+  std::vector<double> q_elem;
+  reserve_huge(q_elem, n_elems);
+  q_elem.resize(n_elems);
   // Corner angles that keep q above target + a margin (1e-3 deg): triangles at least
   // tri_deg, quad corners within [quad_deg, 180 - quad_deg]; their cotangents' bounds.
   const double tri_deg = (triangle_bar_deg * opt.target / triangle_scale) + 1e-3;

@@ -10,6 +10,7 @@
 #include "core/boundary.hpp"
 #include "core/box.hpp"
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace febemesh::dim2 {
 
@@ -79,6 +80,14 @@ struct QuadrantComplex {
   /// Where Boundary node i lies on the curve. Requires kind[i] == NodeKind::Boundary.
   BoundaryLocation& where(std::int32_t i) { return where_[index_of(i)]; }
   const BoundaryLocation& where(std::int32_t i) const { return where_[index_of(i)]; }
+
+  /// Room for n_lattice lattice nodes and n_boundary boundary nodes (add_node's arrays), on
+  /// huge pages where large.
+  void reserve_nodes(std::size_t n_lattice, std::size_t n_boundary) {
+    reserve_huge(points, n_lattice + n_boundary);
+    reserve_huge(kind, n_lattice + n_boundary);
+    reserve_huge(where_, n_boundary);
+  }
 
   /// Lattice nodes (Interior, Chain) first, then Boundary nodes: only these have a location
   /// (32 bytes a node for every node was ~16 bytes an element at the run's memory peak).

@@ -164,3 +164,38 @@ TEMPLATE_TEST_CASE_SIG("smoothing gives the same points on 1, 2 and 3 threads", 
     }
   }
 }
+
+TEST_CASE("smoothing's one-pass neighbour lists (one thread) = the counted ones (threads)", "[smooth][threads]") {
+  // On one thread the node neighbour lists of triangles, quads and lines are written in one
+  // pass; on several they are counted first. A degenerate triangle (a node twice) lists that
+  // node as its own neighbour twice in both; a grid of more than a thousand interior nodes so
+  // that the lists and sweeps run on several threads.
+  const int n = 40;
+  for (const bool slide : {false, true}) {
+    Mesh<2> start = perturbed<2>(n, true, 0.3, 7);
+    // An interior node (the first element's first interior node) twice, with a neighbour.
+    std::size_t e = 0;
+    while (on_grid_boundary<2>(start.points[start.solid.nodes(ElemId{static_cast<std::int32_t>(e)})[0].v], n)) ++e;
+    const VertexId* ev = start.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const VertexId a = ev[0], b = ev[1];
+    start.solid.add(ElemType::Tri3, {a, a, b});
+    SmoothOptions<2> opt;
+    if (slide) {
+      opt.project = [](const Point<2>& p) { return onto_box_facet<2>(p, n); };
+      opt.fixed = box_edges_fixed(start, n);
+    }
+    Mesh<2> one = start;
+    const SmoothStats s1 = smooth(one, opt);
+    CAPTURE(slide);
+    REQUIRE(s1.moves_accepted > 0);
+    for (const int threads : {2, 3}) {
+      Mesh<2> many = start;
+      opt.n_threads = threads;
+      const SmoothStats sn = smooth(many, opt);
+      CAPTURE(threads);
+      CHECK(many.points == one.points);
+      CHECK(sn.moves_accepted == s1.moves_accepted);
+      CHECK(sn.moves_rejected == s1.moves_rejected);
+    }
+  }
+}
