@@ -505,6 +505,8 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 }  // namespace
 
+namespace {
+
 /// One try after every other was refused: mesh3d_facing with `o` within its own work bound of
 /// o.effort first trees. The mesh (its n_octants_built counting `effort` too), or the refusal's
 /// reason in `why`.
@@ -522,6 +524,8 @@ std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o
   }
   return std::nullopt;
 }
+
+}  // namespace
 
 /// mesh3d_raised's refusal `e` (after `effort`): when part of the solid is thin, once more with
 /// the thickness level (Options3d::refused_thickness_cells), and when that is refused too, once
