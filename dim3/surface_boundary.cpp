@@ -352,6 +352,19 @@ Side SurfaceBoundary::classify(const Box<3>& box) const {
   return is_inside(box.center()) ? Side::In : Side::Out;
 }
 
+bool SurfaceBoundary::feature_in_box(std::int32_t t, const Box<3>& box) const {
+  for (int i = 0; i < 3; ++i) {
+    const std::int32_t e = surface_.triangle_edge(t, i);
+    if (features_.is_feature_edge(e)) {
+      const Edge& ab = surface_.edge(e);
+      if (AabbTree::segment_meets_box(surface_.vertices()[ab[0]], surface_.vertices()[ab[1]], box)) return true;
+    }
+    const std::int32_t v = surface_.triangle(t)[i];
+    if (features_.is_corner(v) && box.contains(surface_.vertices()[v])) return true;
+  }
+  return false;
+}
+
 double SurfaceBoundary::control_level(const Box<3>& box) const {
   double level = std::min(options_.global_level, options_.max_level);
   const double feature_level = options_.global_level + options_.feature_extra_levels;
@@ -359,12 +372,19 @@ double SurfaceBoundary::control_level(const Box<3>& box) const {
       options_.thickness_cells > 0 ? std::max(options_.max_level, options_.thickness_max_level) : options_.max_level;
   tree_.for_each_in_box(box, [&](std::int32_t t) {
     if (level >= cap) return;
-    const double wanted =
-        std::max(std::min(std::max(curvature_level_[t], near_feature_[t] ? feature_level : level), options_.max_level),
-                 std::min(thickness_level_[t], options_.thickness_max_level));
-    if (wanted <= level) return;
     const auto& q = tree_.points(t);
-    if (box_triangle_overlap(box, q[0], q[1], q[2])) level = wanted;
+    const auto wanted_at = [&](bool feature) {
+      return std::max(std::min(std::max(curvature_level_[t], feature ? feature_level : level), options_.max_level),
+                      std::min(thickness_level_[t], options_.thickness_max_level));
+    };
+    double wanted = wanted_at(near_feature_[t]);
+    if (wanted <= level) return;
+    if (!box_triangle_overlap(box, q[0], q[1], q[2])) return;
+    if (near_feature_[t] && options_.feature_level_at_edges && !feature_in_box(t, box)) {
+      wanted = wanted_at(false);
+      if (wanted <= level) return;
+    }
+    level = wanted;
   });
   return level;
 }

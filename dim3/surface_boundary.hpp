@@ -30,6 +30,14 @@ struct SurfaceOptions {
   double global_level = 3.0;
   double max_level = 8.0;
   double feature_extra_levels = 1.0;
+  /// Experiment (diagnose3d --feature-at-edges), off: the feature level only where the box meets
+  /// a feature edge or contains a corner, not on every box meeting a triangle that touches one
+  /// (on a coarse tessellation those triangles cover whole thin sheets: rotor's blades).
+  /// Measured (diagnose3d, first tree, leaves / raw inverted tets, off -> on): rotor L6 407,576
+  /// / 25,038 -> 289,472 / 3,125; but at level 4 anchor 13,280 / 1,131 -> 11,152 / 2,021,
+  /// fandisk 9,472 / 1,964 -> 9,192 / 2,005, spool 12,608 / 106 -> 9,696 / 683 (coarser next to
+  /// the features, more folds): not a default.
+  bool feature_level_at_edges = false;
   double arc = 0.5;  ///< radians of bending one cell may span
   /// Octants wanted across the thickness of the solid (ray from each triangle inwards); 0 = off.
   /// Off by default: measured at level 4 it refines spool and rotor where the boundary octants
@@ -108,6 +116,8 @@ class SurfaceBoundary final : public Boundary<3> {
 
  private:
   BoundaryLocation locate(std::int32_t t, const TrianglePoint& tp) const;
+  /// A feature edge of triangle t meets `box`, or a corner of t lies in it.
+  bool feature_in_box(std::int32_t t, const Box<3>& box) const;
   ClosestPoint<3> to_closest(const AabbTree::Closest& c, const P3& p) const;
   P3 pseudo_normal(std::int32_t t, TriangleRegion region) const;
 

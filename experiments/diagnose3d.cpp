@@ -153,6 +153,8 @@ int main(int argc, char** argv) {
   if (argc > 3 && std::string(argv[3]).rfind("--", 0) != 0) so.thickness_cells = std::atof(argv[3]);
   for (int i = 1; i + 1 < argc; ++i)
     if (std::string(argv[i]) == "--feature-extra") so.feature_extra_levels = std::atof(argv[i + 1]);
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--feature-at-edges") so.feature_level_at_edges = true;
   int dump = 0, only = -1;
   bool near_on = false;
   P3 near_p = P3::Zero();

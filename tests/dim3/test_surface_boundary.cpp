@@ -143,6 +143,21 @@ TEST_CASE("level field: global, features, curvature, cap", "[surface_boundary]")
   cube.set_max_level(3.5);
   CHECK(cube.control_level(box(P3(0.9, 0.9, -0.1), P3(1.1, 1.1, 0.1))) == 3.5);
 
+  // A box on the middle of a face meets triangles that touch feature edges (every triangle of
+  // the cube does): the feature level, unless SurfaceOptions::feature_level_at_edges, which asks
+  // the box to meet the feature edge itself or hold a corner.
+  const Box<3> mid_face = box(P3(0.45, 0.45, -0.05), P3(0.55, 0.55, 0.05));
+  CHECK(cube.control_level(mid_face) == 3.5);
+  {
+    SurfaceOptions at_edges;
+    at_edges.feature_level_at_edges = true;
+    SurfaceBoundary c2(cube.surface(), at_edges);
+    c2.set_global_level(3);
+    CHECK(c2.control_level(mid_face) == 3.0);
+    CHECK(c2.control_level(box(P3(0.9, 0.9, -0.1), P3(1.1, 1.1, 0.1))) == 4.0);  // at a corner
+    CHECK(c2.control_level(box(P3(0.45, 0.95, -0.05), P3(0.55, 1.05, 0.05))) == 4.0);  // on an edge
+  }
+
   // Sphere: a cell should span at most `arc` radians: level ~ log2(root side / (r * arc)).
   SurfaceBoundary sphere = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
   const double r = 0.5 * sphere.bounding_box().extent().maxCoeff();
