@@ -242,24 +242,31 @@ std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep)
   return removed;
 }
 
-std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction) {
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads) {
   if (fraction <= 0) return 0;
   std::size_t removed = 0;
   for (int pass = 0; pass < 4; ++pass) {
-    std::vector<std::size_t> drop;
-    for (const FreeFacet<3>& f : free_facets(t, in)) {
-      const auto c = f.corners();
-      const double h = face_size(t, f.cell);
-      P3 centre = P3::Zero();
-      double d = std::numeric_limits<double>::infinity();
-      for (const LP& p : c) {
-        const P3 x = position(t, p);
-        centre += 0.25 * x;
-        d = std::min(d, s.closest_point(x).distance);
+    const std::vector<FreeFacet<3>> facets = free_facets(t, in);
+    std::vector<std::uint8_t> near(facets.size(), 0);
+    for_each_range(facets.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const FreeFacet<3>& f = facets[k];
+        const auto c = f.corners();
+        const double h = face_size(t, f.cell);
+        P3 centre = P3::Zero();
+        double d = std::numeric_limits<double>::infinity();
+        for (const LP& p : c) {
+          const P3 x = position(t, p);
+          centre += 0.25 * x;
+          d = std::min(d, s.closest_point(x).distance);
+        }
+        d = std::min(d, s.closest_point(centre).distance);
+        near[k] = d < fraction * h ? 1 : 0;
       }
-      d = std::min(d, s.closest_point(centre).distance);
-      if (d < fraction * h) drop.push_back(f.leaf);
-    }
+    });
+    std::vector<std::size_t> drop;
+    for (std::size_t k = 0; k < facets.size(); ++k)
+      if (near[k]) drop.push_back(facets[k].leaf);
     std::sort(drop.begin(), drop.end());
     drop.erase(std::unique(drop.begin(), drop.end()), drop.end());
     if (drop.empty()) break;

@@ -109,7 +109,8 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
 std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep);
 
 /// Drop interior octants whose free faces come nearer the surface than `fraction` of their size.
-std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction);
+/// The facets' distances on n_threads threads (the same octants dropped for any count).
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads = 1);
 
 struct BoundaryOctantOptions {
   int max_normals = 4;               ///< local minima tried per node

@@ -309,7 +309,14 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
   const Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
   Flags in = interior_flags(classify(tree, s));
-  apply_buffer(tree, in, s, 0.2);
+  {
+    // The buffer rule's distances on threads: the same octants dropped.
+    Flags in3 = in;
+    const std::size_t dropped = apply_buffer(tree, in, s, 0.2);
+    CHECK(dropped > 0);
+    CHECK(apply_buffer(tree, in3, s, 0.2, 3) == dropped);
+    CHECK(in3 == in);
+  }
   remove_pinches(tree, in);
   keep_largest_components(tree, in, s.n_components());
   const SurfacePointFn sp = [&](const P3& p) {
