@@ -405,33 +405,26 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   // none); they go after the interior ones, into arrays allocated once at their final size.
   // Appending them to the interior ones instead grew every array by doubling and shrank it
   // again: three fresh copies of each, and their page faults.
-  Elements bnd = std::move(m.solid);
-  std::vector<std::uint8_t> bnd_level = std::move(m.level), bnd_from = std::move(m.from_boundary_cell);
-  std::vector<std::int32_t> bnd_cell = std::move(b.out.cell);
-  const std::size_t n_all_tets = n_int_tets + bnd.size();
-  m.solid = Elements{};
-  reserve_huge(m.solid.type, n_all_tets);
-  m.solid.type.assign(n_int_tets, ElemType::Tet4);
-  m.solid.type.insert(m.solid.type.end(), bnd.type.begin(), bnd.type.end());
+  for (std::size_t e = 0; e < m.solid.size(); ++e)
+    MESH_ASSERT(m.solid.type[e] == ElemType::Tet4 && m.solid.offset[e] == static_cast<std::int32_t>(4 * e),
+                "tetrahedralize: a boundary octant's element is not a tetrahedron");
+  const std::size_t n_all_tets = n_int_tets + m.solid.size();
+  // v's n_head first values (pass 3 writes them), then what v held: one fresh allocation.
+  const auto after_head = [](auto& v, std::size_t n_head, const auto& fill) {
+    const auto tail = std::move(v);
+    v = {};
+    reserve_huge(v, n_head + tail.size());
+    v.assign(n_head, fill);
+    v.insert(v.end(), tail.begin(), tail.end());
+  };
+  after_head(m.solid.type, n_int_tets, ElemType::Tet4);
+  after_head(m.solid.node, 4 * n_int_tets, VertexId{});
+  after_head(m.level, n_int_tets, std::uint8_t{0});
+  after_head(m.from_boundary_cell, n_int_tets, std::uint8_t{0});
+  after_head(b.out.cell, n_int_tets, std::int32_t{0});
+  m.solid.offset = {};
   reserve_huge(m.solid.offset, n_all_tets + 1);
   m.solid.offset.resize(n_all_tets + 1);
-  reserve_huge(m.solid.node, 4 * n_all_tets);
-  m.solid.node.resize(4 * n_int_tets);
-  m.solid.node.insert(m.solid.node.end(), bnd.node.begin(), bnd.node.end());
-  reserve_huge(m.level, n_all_tets);
-  m.level.resize(n_int_tets);
-  m.level.insert(m.level.end(), bnd_level.begin(), bnd_level.end());
-  reserve_huge(m.from_boundary_cell, n_all_tets);
-  m.from_boundary_cell.assign(n_int_tets, 0);
-  m.from_boundary_cell.insert(m.from_boundary_cell.end(), bnd_from.begin(), bnd_from.end());
-  reserve_huge(b.out.cell, n_all_tets);
-  b.out.cell.resize(n_int_tets);
-  b.out.cell.insert(b.out.cell.end(), bnd_cell.begin(), bnd_cell.end());
-  for (std::size_t e = 0; e < bnd.size(); ++e)
-    MESH_ASSERT(bnd.type[e] == ElemType::Tet4 && bnd.offset[e] == static_cast<std::int32_t>(4 * e),
-                "tetrahedralize: a boundary octant's element is not a tetrahedron");
-  bnd = Elements{};
-  bnd_level = {}, bnd_from = {}, bnd_cell = {};
   // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
   for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
     const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
