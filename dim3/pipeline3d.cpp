@@ -541,12 +541,14 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
   if (!(s.thin_share(cells * h_feature) > 0)) throw e;
   std::string reasons = e.what(), why;
-  Options3d thick = opt;
+  // Both tries: no level raise, their own work bound of thin_retry_effort first trees.
+  Options3d after = opt;
+  after.raise_levels = 0;
+  after.effort = std::min(opt.effort, opt.thin_retry_effort);
+  after.min_effort_octants = 0;
+  Options3d thick = after;
   thick.thickness_cells = cells;
   thick.buffer = 0.0;  // its one-octant slabs in thin parts project through them (thin retry)
-  thick.raise_levels = 0;
-  thick.effort = std::min(opt.effort, opt.thin_retry_effort);
-  thick.min_effort_octants = 0;
   if (progress)
     progress(std::string("refused (") + e.what() + "): once more with " + std::to_string(cells) +
              " octants across the thin parts, without the buffer rule");
@@ -557,12 +559,9 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
   reasons += "; with " + std::to_string(cells) + " octants across the thin parts: " + why;
   if (!opt.coarse_thin_after_refusal) throw E(reasons);
-  Options3d coarse = opt;
+  Options3d coarse = after;
   coarse.island_refinements = 0;
   coarse.thin_cells = 0.0;
-  coarse.raise_levels = 0;
-  coarse.effort = std::min(opt.effort, opt.thin_retry_effort);
-  coarse.min_effort_octants = 0;
   const double feature_extra = s.feature_extra_levels();
   s.set_feature_extra_levels(0.0);
   if (progress)
