@@ -90,6 +90,20 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
       }
     }
   };
+  // Calls emit(w) once for each distinct w of v's uses, marking them in `seen` and counting
+  // uses[w] when `once`; true when v itself is among them.
+  const auto distinct_uses = [&](std::int32_t self, std::vector<std::int32_t>& seen, std::vector<std::int32_t>& uses,
+                                 auto&& emit) {
+    bool has_self = false;
+    each_use(self, [&](std::int32_t w) {
+      if (once) ++uses[w];
+      if (seen[w] == self) return;
+      seen[w] = self;
+      has_self = has_self || w == self;
+      emit(w);
+    });
+    return has_self;
+  };
   // Sorts v's distinct values [lo, hi), flags `once` from the counts uses[w] of v's uses of w
   // (then cleared), and with has_self lists v a second time, in the slot at hi.
   const auto finish = [&](std::int32_t self, auto lo, auto hi, bool has_self, std::vector<std::int32_t>& uses) {
@@ -120,14 +134,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     for (std::size_t v = 0; v < n; ++v) {
       const auto self = static_cast<std::int32_t>(v);
       const auto first = static_cast<std::ptrdiff_t>(g.item.size());
-      bool has_self = false;
-      each_use(self, [&](std::int32_t w) {
-        if (once) ++uses[w];
-        if (seen[w] == self) return;
-        seen[w] = self;
-        has_self = has_self || w == self;
-        g.item.push_back(w);
-      });
+      const bool has_self = distinct_uses(self, seen, uses, [&](std::int32_t w) { g.item.push_back(w); });
       if (has_self) g.item.push_back(self);  // the second slot (finish moves it into place)
       finish(self, g.item.begin() + first, g.item.end() - (has_self ? 1 : 0), has_self, uses);
       g.start[v + 1] = static_cast<std::int32_t>(g.item.size());
@@ -157,14 +164,8 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
                    for (std::size_t v = begin; v < end; ++v) {
                      const auto self = static_cast<std::int32_t>(v);
                      std::int32_t out = g.start[v];
-                     bool has_self = false;
-                     each_use(self, [&](std::int32_t w) {
-                       if (once) ++uses[w];
-                       if (seen[w] == self) return;
-                       seen[w] = self;
-                       has_self = has_self || w == self;
-                       g.item[static_cast<std::size_t>(out++)] = w;
-                     });
+                     const bool has_self =
+                         distinct_uses(self, seen, uses, [&](std::int32_t w) { g.item[static_cast<std::size_t>(out++)] = w; });
                      finish(self, g.item.begin() + g.start[v], g.item.begin() + out, has_self, uses);
                    }
                  });
