@@ -66,6 +66,22 @@ template <int Dim> double min_quality(const Mesh<Dim>& m) {
   return *std::min_element(q.begin(), q.end());
 }
 
+/// smooth(start, opt) on 2 and 3 threads moves the points and counts the moves as `one` and
+/// `s1`, its run on one thread, did.
+template <int Dim>
+void check_same_on_threads(const Mesh<Dim>& start, SmoothOptions<Dim> opt, const Mesh<Dim>& one, const SmoothStats& s1) {
+  for (const int threads : {2, 3}) {
+    Mesh<Dim> many = start;
+    opt.n_threads = threads;
+    const SmoothStats sn = smooth(many, opt);
+    CAPTURE(threads);
+    CHECK(many.points == one.points);
+    CHECK(sn.moves_accepted == s1.moves_accepted);
+    CHECK(sn.moves_rejected == s1.moves_rejected);
+    CHECK(sn.min_quality_after == s1.min_quality_after);
+  }
+}
+
 }  // namespace
 
 TEMPLATE_TEST_CASE_SIG("smoothing improves a perturbed grid and keeps the boundary", "[smooth]", ((int Dim), Dim), 2, 3) {
@@ -151,16 +167,7 @@ TEMPLATE_TEST_CASE_SIG("smoothing gives the same points on 1, 2 and 3 threads", 
       const SmoothStats s1 = smooth(one, opt);
       CAPTURE(simplices, slide);
       REQUIRE(s1.moves_accepted > 0);
-      for (const int threads : {2, 3}) {
-        Mesh<Dim> many = start;
-        opt.n_threads = threads;
-        const SmoothStats sn = smooth(many, opt);
-        CAPTURE(threads);
-        CHECK(many.points == one.points);
-        CHECK(sn.moves_accepted == s1.moves_accepted);
-        CHECK(sn.moves_rejected == s1.moves_rejected);
-        CHECK(sn.min_quality_after == s1.min_quality_after);
-      }
+      check_same_on_threads(start, opt, one, s1);
     }
   }
 }
@@ -188,14 +195,6 @@ TEST_CASE("smoothing's one-pass neighbour lists (one thread) = the counted ones 
     const SmoothStats s1 = smooth(one, opt);
     CAPTURE(slide);
     REQUIRE(s1.moves_accepted > 0);
-    for (const int threads : {2, 3}) {
-      Mesh<2> many = start;
-      opt.n_threads = threads;
-      const SmoothStats sn = smooth(many, opt);
-      CAPTURE(threads);
-      CHECK(many.points == one.points);
-      CHECK(sn.moves_accepted == s1.moves_accepted);
-      CHECK(sn.moves_rejected == s1.moves_rejected);
-    }
+    check_same_on_threads(start, opt, one, s1);
   }
 }

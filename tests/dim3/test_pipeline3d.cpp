@@ -22,6 +22,17 @@
 using namespace febemesh;
 using namespace febemesh::dim3;
 
+namespace {
+
+/// The boundary of a closed triangle soup (validated as `name`).
+SurfaceBoundary boundary_of(const TriangleSoup& soup, const std::string& name) {
+  Surface surface(soup);
+  validate_surface(surface, name);
+  return SurfaceBoundary(std::move(surface));
+}
+
+}  // namespace
+
 TEST_CASE("sphere966 at level 4 gives a valid mesh close to the sphere's volume", "[pipeline3d]") {
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
   Options3d opt;
@@ -102,9 +113,7 @@ TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part"
   soup.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
                     {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
   const auto refusal = [&](double cells) {
-    Surface surface(soup);
-    validate_surface(surface, "plate");
-    SurfaceBoundary s(std::move(surface));
+    SurfaceBoundary s = boundary_of(soup, "plate");
     Options3d opt;
     opt.level = 3;
     opt.effort = 0.5;
@@ -160,9 +169,7 @@ TEST_CASE("mesh3d leaves out the thin parts after every refining try is refused"
     soup.triangles.push_back({i, 8 + j, 8 + i});
   }
   const auto run = [&](bool coarse, Result3d& r) {
-    Surface surface(soup);
-    validate_surface(surface, "block with a fin");
-    SurfaceBoundary s(std::move(surface));
+    SurfaceBoundary s = boundary_of(soup, "block with a fin");
     Options3d opt;
     opt.level = 4;
     opt.n_threads = 1;
