@@ -204,6 +204,7 @@ int run(const std::vector<std::string>& argv) {
                    {"untangle_node_moves", r.n_untangle_moves},
                    {"optimize_moves", r.n_optimize_moves},
                    {"edges_removed", r.n_edges_removed},
+                   {"edges_contracted", r.n_edges_contracted},
                    {"corners_snapped", r.stats.n_corners_snapped},
                    {"corners_missed", r.stats.n_corners_missed},
                    {"edge_nodes_snapped", r.stats.n_edge_snapped},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <queue>
 #include <utility>
@@ -23,6 +24,12 @@ constexpr double pi = 3.14159265358979323846;
 constexpr double none = -std::numeric_limits<double>::infinity();
 
 double orient(const P3& a, const P3& b, const P3& c, const P3& d) { return (b - a).dot((c - a).cross(d - a)); }
+
+/// The local nodes of a tetrahedron's edge e (0..5).
+std::pair<int, int> tet_edge(int e) {
+  static constexpr int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  return {ends[e][0], ends[e][1]};
+}
 
 /// The mesh as removals edit it. The input's tetrahedra are read from the mesh where they are;
 /// those added live here; dead ones of either stay until the write-back, which compacts the
@@ -46,6 +53,7 @@ struct Work {
   std::vector<Tri> faces;
   std::vector<std::uint8_t> face_alive;
   std::vector<std::vector<std::int32_t>> node_faces;
+  std::vector<std::uint8_t> node_dead;  ///< per node: contracted away
 
   Tet tet(std::int32_t t) const {
     if (t >= n_input) return added[t - n_input];
@@ -114,6 +122,140 @@ struct Work {
       auto& l = node_faces[v];
       l.erase(std::find(l.begin(), l.end(), f));
     }
+  }
+
+  bool on_surface(std::int32_t v) const { return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0; }
+  /// Whether a contraction may remove node u: inside, or on smooth surface; never a kept one.
+  bool removable(std::int32_t u) const {
+    if (node_dead[u] || (!opt.keep.empty() && opt.keep[u])) return false;
+    return !on_surface(u) || where[u].kind == BoundaryLocation::Kind::Smooth;
+  }
+
+  /// The link of node x, or of edge xy (y >= 0), in the mesh closed by a cone from a node
+  /// `outside` (-1) over the interface: its vertices, edges and triangles, sorted, each once.
+  struct Link {
+    std::vector<std::int32_t> v;
+    std::vector<std::array<std::int32_t, 2>> e;
+    std::vector<std::array<std::int32_t, 3>> t;
+  };
+  static constexpr std::int32_t outside = -1;
+  Link link_of(std::int32_t x, std::int32_t y = -2) const {
+    Link l;
+    const auto others = [&](const auto& nodes, std::int32_t* out) {
+      int k = 0;
+      for (const std::int32_t u : nodes)
+        if (u != x && u != y) out[k++] = u;
+      return k;
+    };
+    const auto add = [&](std::int32_t* o, int k) {
+      std::sort(o, o + k);
+      for (int i = 0; i < k; ++i) l.v.push_back(o[i]);
+      for (int i = 0; i < k; ++i)
+        for (int j = i + 1; j < k; ++j) l.e.push_back({o[i], o[j]});
+      if (k == 3) l.t.push_back({o[0], o[1], o[2]});
+    };
+    const auto has_y = [&](const auto& nodes) { return y < 0 || std::find(nodes.begin(), nodes.end(), y) != nodes.end(); };
+    for_tets_at(x, [&](std::int32_t t) {
+      const Tet n = tet(t);
+      if (!has_y(n)) return true;
+      std::int32_t o[3];
+      add(o, others(n, o));
+      return true;
+    });
+    for (const std::int32_t f : node_faces[x]) {
+      if (!has_y(faces[f])) continue;
+      std::int32_t o[3];
+      const int k = others(faces[f], o);
+      o[k] = outside;
+      add(o, k + 1);
+    }
+    const auto unique = [](auto& a) {
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+    };
+    unique(l.v);
+    unique(l.e);
+    unique(l.t);
+    return l;
+  }
+
+  /// Contracts edge uv into v (node u goes) if that raises the worst angle of u's tetrahedra
+  /// by opt.min_gain_deg, keeps every tetrahedron positive, the interface on the surface and the
+  /// mesh a manifold (the link condition); returns whether it did.
+  bool try_contract(std::int32_t u, std::int32_t v, EdgeRemovalStats& st) {
+    if (!removable(u) || node_dead[v]) return false;
+    const bool surface = on_surface(u);
+    if (surface && (!on_surface(v) || !opt.surface_normal)) return false;
+    // u's tetrahedra: those at v go, the others take v for u.
+    std::vector<std::int32_t> at_u;
+    std::vector<Tet> moved;
+    double old_min = std::numeric_limits<double>::infinity(), new_min = old_min;
+    bool ok = true;
+    for_tets_at(u, [&](std::int32_t t) {
+      at_u.push_back(t);
+      old_min = std::min(old_min, q(t));
+      Tet n = tet(t);
+      if (std::find(n.begin(), n.end(), v) != n.end()) return true;
+      std::replace(n.begin(), n.end(), u, v);
+      const double qn = quality(n);
+      ok = qn > 0;
+      new_min = std::min(new_min, qn);
+      moved.push_back(n);
+      return ok;
+    });
+    if (!ok || moved.size() == at_u.size() || !(new_min > old_min + opt.min_gain_deg * pi / 180.0)) return false;
+    // u's interface triangles: the two at uv go (a surface edge), the others take v.
+    const std::vector<std::int32_t> faces_u = node_faces[u];
+    std::vector<Tri> moved_faces;
+    if (surface) {
+      int at_uv = 0;
+      double old_fit = 1.0, new_fit = 1.0;
+      for (const std::int32_t f : faces_u) {
+        old_fit = std::min(old_fit, fit(faces[f]));
+        Tri n = faces[f];
+        if (std::find(n.begin(), n.end(), v) != n.end()) {
+          ++at_uv;
+          continue;
+        }
+        std::replace(n.begin(), n.end(), u, v);
+        new_fit = std::min(new_fit, fit(n));
+        moved_faces.push_back(n);
+      }
+      // Within 25 deg of the surface normals, or no worse than before.
+      if (at_uv != 2 || !(new_fit > 0 && (new_fit >= old_fit || new_fit >= 0.9))) return false;
+    } else if (!faces_u.empty()) {
+      return false;
+    }
+    // The link condition: Lk(u) and Lk(v) meet in Lk(uv) exactly (vertices and edges; no
+    // triangle), and u's link is a closed surface (u is inside the closed complex).
+    const Link lu = link_of(u), lv = link_of(v), luv = link_of(u, v);
+    {
+      std::vector<int> uses(lu.e.size(), 0);
+      for (const auto& t : lu.t)
+        for (int i = 0; i < 3; ++i)
+          for (int j = i + 1; j < 3; ++j) {
+            const std::array<std::int32_t, 2> e = {t[i], t[j]};
+            ++uses[static_cast<std::size_t>(std::lower_bound(lu.e.begin(), lu.e.end(), e) - lu.e.begin())];
+          }
+      if (std::any_of(uses.begin(), uses.end(), [](int n) { return n != 2; })) return false;
+    }
+    const auto meet = [](const auto& a, const auto& b) {
+      std::decay_t<decltype(a)> out;
+      std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
+      return out;
+    };
+    if (meet(lu.v, lv.v) != luv.v || meet(lu.e, lv.e) != luv.e || !meet(lu.t, lv.t).empty()) return false;
+    std::size_t k = 0;
+    for (const std::int32_t t : at_u) {
+      const Tet n = tet(t);
+      kill_tet(t);
+      if (std::find(n.begin(), n.end(), v) == n.end()) add_tet(moved[k++], t);
+    }
+    for (const std::int32_t f : faces_u) kill_face(f);
+    for (const Tri& f : moved_faces) add_face(f);
+    node_dead[u] = 1;
+    ++st.contracted;
+    return true;
   }
 
   /// Removes edge ab if a triangulation of its link raises the worst angle around it by
@@ -253,7 +395,7 @@ struct Work {
 
 EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
                                   const EdgeRemovalOptions& opt) {
-  Work w{mesh, where, opt, 0, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
+  Work w{mesh, where, opt, 0, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}};
   const std::size_t n = mesh.points.size();
   w.n_input = static_cast<std::int32_t>(mesh.solid.size());
   for (std::size_t e = 0; e < mesh.solid.size(); ++e)
@@ -284,6 +426,8 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
       opt.n_threads, w.at_start, w.at_list);
   w.at_added.resize(n);
   w.node_faces.resize(n);
+  w.node_dead.assign(n, 0);
+  const double contract_below = opt.contract_below_deg * pi / 180.0;
   for (std::size_t f = 0; f < mesh.interface.size(); ++f) {
     MESH_ASSERT(mesh.interface.type[f] == ElemType::Tri3, "remove_bad_edges needs interface triangles");
     const VertexId* v = mesh.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
@@ -300,10 +444,23 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
     bool done = false;
     for (int i = 0; i < 4 && !done; ++i)
       for (int j = i + 1; j < 4 && !done; ++j) done = w.try_remove(nodes[i], nodes[j], st);
+    if (!done && w.q(t) < contract_below) {
+      // Its edges, shortest first (ties in edge order); each way round.
+      std::array<std::pair<double, int>, 6> edges;
+      for (int e = 0; e < 6; ++e) {
+        const auto [i, j] = tet_edge(e);
+        edges[e] = {(mesh.points[nodes[i]] - mesh.points[nodes[j]]).squaredNorm(), e};
+      }
+      std::sort(edges.begin(), edges.end());
+      for (int k = 0; k < 6 && !done; ++k) {
+        const auto [i, j] = tet_edge(edges[k].second);
+        done = w.try_contract(nodes[i], nodes[j], st) || w.try_contract(nodes[j], nodes[i], st);
+      }
+    }
     for (std::int32_t k = first_new; k < w.n_tets(); ++k)
       if (w.q(k) < below) todo.push({w.q(k), k});
   }
-  if (st.removed == 0) return st;
+  if (st.removed == 0 && st.contracted == 0) return st;
   // The lists are done with: free them before the element arrays grow.
   std::vector<std::int32_t>().swap(w.at_list);
   std::vector<std::int32_t>().swap(w.at_start);
@@ -356,6 +513,19 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   for (std::size_t f = 0; f < w.faces.size(); ++f)
     if (w.face_alive[f]) interface.add(ElemType::Tri3, {VertexId{w.faces[f][0]}, VertexId{w.faces[f][1]}, VertexId{w.faces[f][2]}});
   mesh.interface = std::move(interface);
+  if (st.contracted > 0) {
+    // Compact the nodes: the removed ones go, the others keep their order.
+    st.node_map.assign(n, -1);
+    std::int32_t kept = 0;
+    for (std::size_t v = 0; v < n; ++v)
+      if (!w.node_dead[v]) st.node_map[v] = kept++;
+    remap_nodes(st.node_map, mesh.points);
+    for (Elements* elems : {&mesh.solid, &mesh.interface})
+      for (VertexId& v : elems->node) {
+        MESH_ASSERT(st.node_map[v.v] >= 0, "a removed node is still used");
+        v.v = st.node_map[v.v];
+      }
+  }
   return st;
 }
 

@@ -11,6 +11,14 @@
 // angle at a surface edge), so four tetrahedra around a surface edge whose interface triangles
 // meet at 62 deg stay under 15.5 deg whatever their free nodes do (anchor L5, a surface edge
 // across a concave feature line the surface mesh misses: its five tetrahedra under 10 deg).
+//
+// Edge contraction, where no removal helps a tetrahedron under opt.contract_below_deg: node u
+// of a short edge uv goes, its tetrahedra at v go with it, and its other tetrahedra and interface
+// triangles take v instead. Neither removal nor node moves can lengthen an edge that the surface
+// mesh pins short: fandisk L5's seven tetrahedra under 15 deg all hold a surface edge of 0.0012
+// (a smooth-surface node beside a feature-line node) among edges of 0.015-0.03. Taken only when
+// the link condition holds (Dey et al.: the links of u and v meet in the link of uv, the
+// interface closed by a cone from outside), so the mesh stays a manifold of the same topology.
 
 #include <cstdint>
 #include <functional>
@@ -35,6 +43,15 @@ struct EdgeRemovalOptions {
   /// normals at its nodes does not drop, and stays positive), and never an edge between two
   /// feature-line or corner nodes (it may be the feature line itself).
   std::function<Point<3>(const BoundaryLocation&)> surface_normal;
+  /// Tetrahedra below this (degrees) whose edges no removal mends try contracting an edge,
+  /// shortest first. 0: never. A contraction is taken if it raises the worst angle of the
+  /// tetrahedra at the node it removes by min_gain_deg. Only nodes inside or on smooth surface
+  /// (where.kind Smooth) go, a surface node only into another surface node along an interface
+  /// edge, and then only if the new interface triangles fit the surface (as for a surface swap:
+  /// needs surface_normal). The mesh's nodes are renumbered (EdgeRemovalStats::node_map).
+  double contract_below_deg = 0.0;
+  /// Per node: 1 = never contracted away (feature corners, nodes the optimiser keeps). Empty: none.
+  std::vector<std::uint8_t> keep;
   /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
   /// on one); the result is the same for every count.
   int n_threads = 1;
@@ -46,14 +63,30 @@ struct EdgeRemovalStats {
   /// With `cell`: the cells (ascending, each once) that lost a tetrahedron, so whose
   /// tetrahedra are no longer their template's (make_hex_dominant leaves them as they are).
   std::vector<std::int32_t> cells_changed;
+  std::size_t contracted = 0;  ///< edges contracted (nodes removed)
+  /// With contractions: old node id -> new one (-1: removed); the mesh's points are compacted
+  /// in order. Empty when no node was removed. Per-node arrays of the caller follow it
+  /// (remap_nodes).
+  std::vector<std::int32_t> node_map;
 };
 
 /// Removes edges of bad tetrahedra from `mesh` (all Tet4; interface all Tri3, outward) while a
-/// removal raises the worst angle around its edge. `where` (per node, patch >= 0 on the surface)
-/// is read only. Per-element arrays stay in step: mesh.level, mesh.from_boundary_cell and, if
+/// removal raises the worst angle around its edge, and contracts edges of those still under
+/// opt.contract_below_deg. `where` (per node, patch >= 0 on the surface) is read only; after a
+/// contraction it, like every per-node array, needs remap_nodes(stats.node_map, ...). Per-element arrays stay in step: mesh.level, mesh.from_boundary_cell and, if
 /// not null, `cell` (new tetrahedra take the values of the first tetrahedron they replace).
 /// Element order changes: survivors keep their order, new ones come last.
 EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
                                   const EdgeRemovalOptions& opt);
+
+/// values[node_map[v]] = values[v] for the kept nodes, in order; the removed ones' entries go.
+/// Nothing when node_map is empty or values is (an unused per-node array).
+template <class T> void remap_nodes(const std::vector<std::int32_t>& node_map, std::vector<T>& values) {
+  if (node_map.empty() || values.empty()) return;
+  std::size_t k = 0;
+  for (std::size_t v = 0; v < node_map.size() && v < values.size(); ++v)
+    if (node_map[v] >= 0) values[k++] = values[v];
+  values.resize(k);
+}
 
 }  // namespace febemesh::dim3

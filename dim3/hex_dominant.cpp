@@ -159,6 +159,17 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     ci.apex = apex;
   }
 
+  // The complex's node ids as the mesh numbers them now (contractions remove nodes). A removed
+  // node only belongs to changed cells: every tetrahedron at it was replaced.
+  const auto node = [&fe](std::int32_t id) {
+    if (fe.node_map.empty()) return id;
+    MESH_ASSERT(fe.node_map[static_cast<std::size_t>(id)] >= 0, "node " << id << " was contracted away");
+    return fe.node_map[static_cast<std::size_t>(id)];
+  };
+  const auto mapped = [&](Ring4 r) {
+    for (std::int32_t& id : r) id = node(id);
+    return r;
+  };
   Faces faces;
   for (std::size_t k = 0; k < n_interior; ++k) {
     CellInfo& ci = cells[k];
@@ -173,14 +184,14 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
       // Sub-squares against finer octants are quads too: pyramids from this cell's centroid.
       quads.clear();
       plain_squares(oc.lattice, q, length(c), quads);
-      for (const Ring4& r : quads) add_quad(m, ci, faces, r, false);
+      for (const Ring4& r : quads) add_quad(m, ci, faces, mapped(r), false);
     }
     if (n_plain == Cube<3>::n_faces) {
       // Gmsh order: corners 0 1 3 2 (z low, counter-clockwise seen from above), then above them.
       constexpr std::array<int, 8> gmsh = {0, 1, 3, 2, 4, 5, 7, 6};
       for (int i = 0; i < 4; ++i) {
-        ci.lower[i] = oc.lattice.find(corner(c, gmsh[i]));
-        ci.upper[i] = oc.lattice.find(corner(c, gmsh[i + 4]));
+        ci.lower[i] = node(oc.lattice.find(corner(c, gmsh[i])));
+        ci.upper[i] = node(oc.lattice.find(corner(c, gmsh[i + 4])));
       }
       ci.candidate = true;
     }
@@ -190,8 +201,8 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     if (ci.cones.empty() || ci.changed) continue;
     const BoundaryOctant& bo = oc.boundary[k];
     const std::size_t n = bo.ring.size();
-    std::vector<std::int32_t> p(n);
-    for (std::size_t i = 0; i < n; ++i) p[i] = oc.projection[bo.ring[i]];
+    std::vector<std::int32_t> ring(n), p(n);
+    for (std::size_t i = 0; i < n; ++i) ring[i] = node(bo.ring[i]), p[i] = node(oc.projection[bo.ring[i]]);
     int n_plain = 0;
     const auto& fc = FaceCorners<3>::corners[bo.face];
     const std::array<LP, 4> sq{corner(bo.cell, fc[0]), corner(bo.cell, fc[1]), corner(bo.cell, fc[2]),
@@ -200,10 +211,10 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     std::vector<Ring4> quads;
     plain_squares(oc.lattice, sq, length(bo.cell), quads);
     // Seen from the boundary octant, the interior octant's face turns the other way.
-    for (const Ring4& q : quads) add_quad(m, ci, faces, {q[0], q[3], q[2], q[1]}, false);
+    for (const Ring4& q : quads) add_quad(m, ci, faces, mapped({q[0], q[3], q[2], q[1]}), false);
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t j = (i + 1) % n;
-      const Ring4 side{bo.ring[i], bo.ring[j], p[j], p[i]};
+      const Ring4 side{ring[i], ring[j], p[j], p[i]};
       if (!distinct(side)) continue;
       add_quad(m, ci, faces, side, false);
       ++n_plain;
@@ -217,7 +228,7 @@ HexDominantStats make_hex_dominant(const Orthtree<3>& t, const OctantComplex& oc
     }
     if (n == 4 && n_plain == Cube<3>::n_faces) {
       // The ring turns counter-clockwise seen from the projections: the lower face of the hex.
-      for (int i = 0; i < 4; ++i) ci.lower[i] = bo.ring[i], ci.upper[i] = p[i];
+      for (int i = 0; i < 4; ++i) ci.lower[i] = ring[i], ci.upper[i] = p[i];
       ci.candidate = true;
     }
   }

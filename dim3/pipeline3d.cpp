@@ -982,15 +982,31 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           if (opt.hex_dominant) eo.below_deg = std::min(eo.below_deg, opt.hex.min_dihedral_deg);
           eo.surface_normal = surface_normal;
           eo.n_threads = opt.n_threads;
+          eo.contract_below_deg = opt.contract_edges_below_deg;
+          // Contractions keep the corners. Nodes snapped onto a feature line may go (into a node
+          // of theirs): those the sweeps keep fixed include some whose closest point is on a
+          // face beside the line (fandisk L5: the smooth-surface end of a 0.0012 edge whose
+          // seven tetrahedra stayed under 15 deg).
+          std::vector<std::uint8_t> corners = fixed_nodes(oc.complex, fe, false);
           for (int round = 0; round < 3; ++round) {
+            eo.keep = corners;
             const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
             r.n_edges_removed += es.removed;
+            r.n_edges_contracted += es.contracted;
+            for (auto* per_node : {&corners, &to.fixed, &to.on_line}) remap_nodes(es.node_map, *per_node);
+            remap_nodes(es.node_map, fe.where);
+            if (!es.node_map.empty()) {  // the template's node ids -> today's (make_hex_dominant)
+              if (fe.node_map.empty()) fe.node_map = es.node_map;
+              else
+                for (std::int32_t& id : fe.node_map)
+                  if (id >= 0) id = es.node_map[static_cast<std::size_t>(id)];
+            }
             // With --elements hex those cells stay tetrahedra (make_hex_dominant).
             std::vector<std::int32_t> changed;
             std::set_union(fe.cells_changed.begin(), fe.cells_changed.end(), es.cells_changed.begin(),
                            es.cells_changed.end(), std::back_inserter(changed));
             fe.cells_changed = std::move(changed);
-            if (es.removed == 0) break;
+            if (es.removed == 0 && es.contracted == 0) break;
             r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
           }
         }

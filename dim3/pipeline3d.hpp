@@ -74,6 +74,10 @@ struct Options3d {
   /// pass; up to three rounds while edges go. 0 = none. With hex_dominant the cells whose
   /// tetrahedra it changed stay tetrahedra (TetMesh::cells_changed).
   double remove_edges_below_deg = 30.0;  // the sweeps' target_dihedral_deg
+  /// In those rounds, tetrahedra still under this angle (degrees) where no removal helps try
+  /// contracting a short edge (EdgeRemovalOptions::contract_below_deg; nodes are removed, and
+  /// with hex_dominant their cells stay tetrahedra). 0 = none.
+  double contract_edges_below_deg = 15.0;
   int max_repairs = 12;              ///< local refinements when the construction needs them
   /// Repairs that may leave more problems than the tree before them: a try stops at the next
   /// one that does ("the last one made it worse"). Refining around inverted tetrahedra moves
@@ -181,6 +185,7 @@ struct Result3d {
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
   std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
   std::size_t n_edges_removed = 0;   ///< edges removed after it (remove_edges_below_deg)
+  std::size_t n_edges_contracted = 0;  ///< edges contracted there (contract_edges_below_deg)
   HexDominantStats hex;              ///< with opt.hex_dominant
   std::vector<StageTime3> times;
 };

@@ -41,6 +41,9 @@ struct TetMesh {
   /// Cells (ascending, each once) whose tetrahedra are no longer the template's cones: edge
   /// removal (dim3/edge_removal.hpp) replaced some of them. make_hex_dominant keeps them tets.
   std::vector<std::int32_t> cells_changed;
+  /// Per node as tetrahedralize made them (the complex's nodes first): its id now, -1 where an
+  /// edge contraction removed it (dim3/edge_removal.hpp). Empty: the ids are unchanged.
+  std::vector<std::int32_t> node_map;
   std::size_t n_dropped_degenerate = 0;  ///< cones with a repeated node (degenerate octants)
   std::size_t n_fins_cancelled = 0;      ///< pairs of back-to-back triangles of one cell, dropped
 };

@@ -13,7 +13,7 @@
 //   other     - all projections go out and land facing the face: shear between neighbours.
 // Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]
 // --pipeline runs the whole pipeline instead; with --quality it sorts the final mesh's tetrahedra
-// under 10 degrees by where they come from (print_quality_diagnosis).
+// under 10 degrees (--below DEG) by where they come from (print_quality_diagnosis).
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
 // retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
 // --opposing drops the interior octants at nodes with opposing free faces (remove_opposing,
@@ -80,7 +80,7 @@ std::array<double, 6> tet_dihedral_angles_deg(const P3& a, const P3& b, const P3
 /// pipeline: how many tetrahedra fall under 5/10/15 degrees, which cells they come from
 /// (interior octants or boundary octants), what their nodes are (interior, smooth surface,
 /// feature line, corner) and whether their worst edge is an edge of the surface mesh.
-void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int dump) {
+void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int dump, double below) {
   const Mesh<3>& m = r.fe.mesh;
   const std::vector<BoundaryLocation>& where = r.fe.where;
   std::size_t n_interior_cells = 0;
@@ -113,7 +113,7 @@ void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int du
     const int worst_edge = static_cast<int>(std::min_element(ang.begin(), ang.end()) - ang.begin());
     const double deg = ang[worst_edge];
     for (int b = 0; b < 4; ++b) n_under[b] += deg < bars[b] ? 1 : 0;
-    if (deg >= 10) continue;
+    if (deg >= below) continue;
     worst.push_back({deg, e});
     int nk[4] = {0, 0, 0, 0};
     for (int k = 0; k < 4; ++k) ++nk[kind(v[k].v)];
@@ -220,7 +220,10 @@ int main(int argc, char** argv) {
       return 0;
     }
   bool quality = false;
+  double below = 10.0;  // --below DEG: the tetrahedra the quality diagnosis sorts and dumps
   for (int i = 1; i < argc; ++i) quality = quality || std::string(argv[i]) == "--quality";
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::string(argv[i]) == "--below") below = std::atof(argv[i + 1]);
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--pipeline") {
       const auto t0 = std::chrono::steady_clock::now();
@@ -236,7 +239,7 @@ int main(int argc, char** argv) {
         min_dihedral = summarize_quality(r.fe.mesh).min_angle_deg;
         vol_err = measure_fidelity(r.fe.mesh, s, 1).volume_rel_error;
         repairs = r.n_repairs;
-        if (quality) print_quality_diagnosis(r, s, dump);
+        if (quality) print_quality_diagnosis(r, s, dump, below);
       } catch (const std::exception& e) {
         verdict = std::string("refused: ") + e.what();
         if (verdict.size() > 300) verdict.resize(300);

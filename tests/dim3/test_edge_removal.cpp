@@ -1,6 +1,8 @@
 // edge_removal: removing an edge keeps the region filled (inside: the same volume; at a convex
 // surface edge: less by the tetrahedron cut off), inverts nothing and raises the worst angle; the
-// surface edge of anchor level 5 that held its five tetrahedra under 10 deg is swapped.
+// surface edge of anchor level 5 that held its five tetrahedra under 10 deg is swapped. Edge
+// contraction removes the node of a short edge, inside or on the surface, and leaves a valid
+// mesh (the validator: conforming, interface = boundary, no unused node) of the same volume.
 
 #include <catch2/catch.hpp>
 #include <rapidcheck.h>
@@ -13,6 +15,7 @@
 #include "core/mesh.hpp"
 #include "core/read_msh.hpp"
 #include "core/test_mesh_fixtures.hpp"
+#include "core/validate.hpp"
 #include "dim3/edge_removal.hpp"
 #include "dim3/tet_optimize.hpp"
 #include "property.hpp"
@@ -165,5 +168,145 @@ TEST_CASE("edge removal inside a jittered cube keeps the volume and raises the w
     RC_ASSERT(min_dihedral(m) >= before - 1e-9);
     RC_ASSERT(faces_match(m));
     RC_ASSERT(st.removed > 0 || m.solid.size() == n_before);
+  });
+}
+
+namespace {
+
+/// A 4x4x4 Kuhn grid whose node `u` is moved to 1 - t of the way to its neighbour `v` along a
+/// grid edge, for the largest t in 0.95, 0.9, ... that keeps every tetrahedron positive: the
+/// short edge uv leaves tetrahedra under 10 deg that no edge removal mends.
+Mesh<3> pinched_grid(int u, int v, std::vector<BoundaryLocation>& where) {
+  Mesh<3> m;
+  for (double t = 0.95; t > 0.4; t -= 0.05) {
+    m = test::grid_mesh<3>(4, true);
+    m.points[u] += t * (m.points[v] - m.points[u]);
+    bool positive = true;
+    for (std::size_t e = 0; e < m.solid.size(); ++e) positive = positive && volume6(m, e) > 0;
+    if (positive) break;
+  }
+  // Surface nodes: patch = the face (0..5: x = 0, x = 4, y = 0, ...); kind Smooth inside a face,
+  // FeatureEdge on the cube's edges, Corner at its corners.
+  where.assign(m.points.size(), BoundaryLocation{});
+  const P3 moved = m.points[u];
+  const Mesh<3> plain = test::grid_mesh<3>(4, true);
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const P3& x = plain.points[i];
+    int n_faces = 0;
+    for (int d = 0; d < 3; ++d)
+      for (int side = 0; side < 2; ++side)
+        if (x[d] == 4.0 * side) {
+          if (n_faces == 0) where[i].patch = 2 * d + side;
+          ++n_faces;
+        }
+    where[i].kind = n_faces <= 1 ? BoundaryLocation::Kind::Smooth
+                    : n_faces == 2 ? BoundaryLocation::Kind::FeatureEdge
+                                   : BoundaryLocation::Kind::Corner;
+  }
+  (void)moved;
+  return m;
+}
+P3 cube_normal(const BoundaryLocation& w) {
+  P3 n = P3::Zero();
+  n[w.patch / 2] = w.patch % 2 == 0 ? -1.0 : 1.0;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("edge contraction removes the node of a short edge", "[edge_removal]") {
+  // Grid node ids: x + 5 (y + 5 z).
+  const auto id = [](int x, int y, int z) { return x + 5 * (y + 5 * z); };
+  struct Case {
+    const char* name;
+    int u, v;
+    bool surface;
+  };
+  for (const Case& c : {Case{"inside", id(2, 2, 2), id(3, 2, 2), false}, Case{"on a face", id(2, 2, 0), id(3, 2, 0), true}}) {
+    SECTION(c.name) {
+      std::vector<BoundaryLocation> where;
+      Mesh<3> m = pinched_grid(c.u, c.v, where);
+      const double vol = total_volume6(m), before = min_dihedral(m);
+      const std::size_t n_nodes = m.points.size();
+      REQUIRE(before < 10.0);
+      std::vector<std::int32_t> cell(m.solid.size());
+      for (std::size_t e = 0; e < cell.size(); ++e) cell[e] = static_cast<std::int32_t>(e);
+      EdgeRemovalOptions eo;
+      eo.below_deg = 30.0;
+      eo.surface_normal = cube_normal;
+      {
+        Mesh<3> removal_only = m;
+        std::vector<std::int32_t> cell2 = cell;
+        remove_bad_edges(removal_only, where, &cell2, eo);
+        CHECK(min_dihedral(removal_only) < 10.0);
+      }
+      eo.contract_below_deg = 15.0;
+      const EdgeRemovalStats st = remove_bad_edges(m, where, &cell, eo);
+      remap_nodes(st.node_map, where);
+      const double after = min_dihedral(m);
+      INFO(c.name << ": min dihedral " << before << " -> " << after << " deg, " << st.contracted << " contracted, "
+                  << st.removed << " removed");
+      CHECK(st.contracted >= 1);
+      CHECK(m.points.size() == n_nodes - st.contracted);
+      CHECK(where.size() == m.points.size());
+      CHECK(cell.size() == m.solid.size());
+      CHECK(after > before + 10.0);
+      const ValidationReport v = validate(m, ValidateOptions<3>{});
+      INFO(v.summary());
+      CHECK(v.valid);
+      CHECK(faces_match(m));
+      // Every surface node is still on a face of the cube, so the volume is the cube's.
+      CHECK(std::abs(total_volume6(m) - vol) <= 1e-12 * vol);
+      for (const VertexId n : m.interface.node) CHECK(where[n.v].patch >= 0);
+      CHECK(c.surface == (st.contracted > 0 && m.interface.size() < test::grid_mesh<3>(4, true).interface.size()));
+    }
+  }
+  SECTION("never a kept node, a feature-line node or a corner") {
+    std::vector<BoundaryLocation> where;
+    Mesh<3> m = pinched_grid(id(2, 2, 0), id(3, 2, 0), where);
+    EdgeRemovalOptions eo;
+    eo.surface_normal = cube_normal;
+    eo.contract_below_deg = 30.0;
+    eo.keep.assign(m.points.size(), 0);
+    eo.keep[id(2, 2, 0)] = eo.keep[id(3, 2, 0)] = 1;
+    const std::vector<P3> points = m.points;
+    const EdgeRemovalStats st = remove_bad_edges(m, where, nullptr, eo);
+    CHECK(m.points.size() == points.size() - st.contracted);
+    for (std::size_t v = 0; v < points.size() && !st.node_map.empty(); ++v) {
+      const bool must_stay = eo.keep[v] || where[v].kind != BoundaryLocation::Kind::Smooth;
+      if (!must_stay) continue;
+      CAPTURE(v);
+      REQUIRE(st.node_map[v] >= 0);
+      CHECK(m.points[static_cast<std::size_t>(st.node_map[v])] == points[v]);
+    }
+    CHECK(validate(m, ValidateOptions<3>{}).valid);
+  }
+}
+
+TEST_CASE("edge contraction inside a jittered cube keeps a valid mesh of the same volume", "[edge_removal][property]") {
+  test::prop("jittered Kuhn cubes, contractions", 20, [](unsigned seed) {
+    Mesh<3> m = test::grid_mesh<3>(3, true);
+    std::uint64_t s = seed;
+    const auto rnd = [&] {
+      s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+      return double(s >> 11) / double(1ULL << 53) - 0.5;
+    };
+    for (P3& x : m.points)
+      if (x.minCoeff() > 0 && x.maxCoeff() < 3) x += 0.8 * P3(rnd(), rnd(), rnd());
+    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_PRE(volume6(m, e) > 0);
+    // Hull nodes are surface nodes without a normal: only inside nodes may go.
+    std::vector<BoundaryLocation> where(m.points.size());
+    for (const VertexId n : m.interface.node) where[n.v].patch = 0;
+    const double vol = total_volume6(m), before = min_dihedral(m);
+    EdgeRemovalOptions eo;
+    eo.below_deg = 30.0;
+    eo.contract_below_deg = 30.0;
+    const EdgeRemovalStats st = remove_bad_edges(m, where, nullptr, eo);
+    RC_TAG(st.contracted > 0 ? "contracted" : "none");
+    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_ASSERT(volume6(m, e) > 0);
+    RC_ASSERT(std::abs(total_volume6(m) - vol) <= 1e-12 * vol);
+    RC_ASSERT(min_dihedral(m) >= before - 1e-9);
+    RC_ASSERT(faces_match(m));
+    RC_ASSERT(validate(m, ValidateOptions<3>{}).valid);
   });
 }
