@@ -534,14 +534,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         share(pnode[k - 1]);
         continue;
       }
-      // Closes onto the chain's first boundary node: at v[0] + n, or a rounding error short of
-      // it. An order-constrained projection pinned at that end (below) stops up to 1e-15 n
-      // short, a different parameter for the same point: two nodes 1e-16 apart, joined by an
-      // interface element of zero length (property suite, mixed, case 9764: worm3 at level 7,
-      // whose last 20 chain nodes all project onto the first one's point). 1e-13 of a piece is
-      // far below any distance the validator tells from a duplicate.
-      if (k > 0 && v[k] != v[0] + n && v[0] + n - v[k] <= 1e-13) v[k] = v[0] + n;
-      if (k > 0 && v[k] == v[0] + n) {
+      if (k > 0 && v[k] == v[0] + n) {  // closes onto the chain's first boundary node
         share(pnode[0]);
         continue;
       }
@@ -567,7 +560,14 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
         share(pnode[k - 1]);
         continue;
       }
-      if (k > 0 && k + 1 == m && (qc.points[pnode[0]] - p).norm() <= eps) {
+      // Likewise the chain's end onto its first node: any node of the loop's second half at its
+      // point, not only the last. An order-constrained projection pinned at the end of the range
+      // (above) stops short of v[0] + n: by 1e-15 n (golden section; the property suite's mixed
+      // and quad case 9764, worm3 at level 7, whose last 20 chain nodes all land on the first
+      // one's point), or by 8e-6 at a corner, where the spline's speed vanishes (mixed, star+1
+      // holes at level 6: 1e-17 from the corner node). Apart, they were two nodes 1e-16 apart
+      // joined by an interface element of zero length.
+      if (k > 0 && v[k] > v[0] + 0.5 * n && (qc.points[pnode[0]] - p).norm() <= eps) {
         share(pnode[0]);
         continue;
       }
