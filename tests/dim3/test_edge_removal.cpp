@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numeric>
 
 #include "core/mesh.hpp"
 #include "core/read_msh.hpp"
@@ -84,6 +85,28 @@ Mesh<3> anchor_ridge(std::vector<BoundaryLocation>& where) {
 }
 P3 anchor_normal(const BoundaryLocation& w) { return w.patch == 0 ? P3(0, 0, 1) : P3(0, 1, 0); }
 
+/// Each tetrahedron its own cell (cell[e] = e), to follow them through removals.
+std::vector<std::int32_t> own_cells(const Mesh<3>& m) {
+  std::vector<std::int32_t> cell(m.solid.size());
+  std::iota(cell.begin(), cell.end(), 0);
+  return cell;
+}
+
+/// The 3x3x3 Kuhn grid with each inside node moved by up to amount / 2 along each axis (an LCG
+/// seeded by `seed`); a case with a tetrahedron that is not positive is discarded (RC_PRE).
+Mesh<3> jittered_kuhn_grid(unsigned seed, double amount) {
+  Mesh<3> m = test::grid_mesh<3>(3, true);
+  std::uint64_t s = seed;
+  const auto rnd = [&] {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(s >> 11) / double(1ULL << 53) - 0.5;
+  };
+  for (P3& x : m.points)
+    if (x.minCoeff() > 0 && x.maxCoeff() < 3) x += amount * P3(rnd(), rnd(), rnd());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) RC_PRE(volume6(m, e) > 0);
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("edge removal mends the anchor L5 surface edge that no node move can", "[edge_removal]") {
@@ -93,8 +116,7 @@ TEST_CASE("edge removal mends the anchor L5 surface edge that no node move can",
   const double before = min_dihedral(m), vol = total_volume6(m);
   const std::size_t n_interface = m.interface.size();
   CHECK(before < 9.5);
-  std::vector<std::int32_t> cell(m.solid.size());
-  for (std::size_t e = 0; e < cell.size(); ++e) cell[e] = static_cast<std::int32_t>(e);
+  std::vector<std::int32_t> cell = own_cells(m);
   // The optimiser may move the two inside nodes whose tetrahedra are all here (22900, 67692);
   // the surface nodes stay (no projection), and so do the nodes at the cut.
   TetOptimizeOptions to;
@@ -145,18 +167,10 @@ TEST_CASE("edge removal mends the anchor L5 surface edge that no node move can",
 
 TEST_CASE("edge removal inside a jittered cube keeps the volume and raises the worst angle", "[edge_removal][property]") {
   test::prop("jittered Kuhn cubes", 20, [](unsigned seed) {
-    Mesh<3> m = test::grid_mesh<3>(3, true);
+    Mesh<3> m = jittered_kuhn_grid(seed, 0.6);
     m.interface.clear();
     m.level.clear();
     m.from_boundary_cell.clear();
-    std::uint64_t s = seed;
-    const auto rnd = [&] {
-      s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-      return double(s >> 11) / double(1ULL << 53) - 0.5;
-    };
-    for (P3& x : m.points)
-      if (x.minCoeff() > 0 && x.maxCoeff() < 3) x += 0.6 * P3(rnd(), rnd(), rnd());
-    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_PRE(volume6(m, e) > 0);
     const double vol = total_volume6(m), before = min_dihedral(m);
     const std::size_t n_before = m.solid.size();
     EdgeRemovalOptions eo;
@@ -188,7 +202,6 @@ Mesh<3> pinched_grid(int u, int v, std::vector<BoundaryLocation>& where) {
   // Surface nodes: patch = the face (0..5: x = 0, x = 4, y = 0, ...); kind Smooth inside a face,
   // FeatureEdge on the cube's edges, Corner at its corners.
   where.assign(m.points.size(), BoundaryLocation{});
-  const P3 moved = m.points[u];
   const Mesh<3> plain = test::grid_mesh<3>(4, true);
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const P3& x = plain.points[i];
@@ -203,7 +216,6 @@ Mesh<3> pinched_grid(int u, int v, std::vector<BoundaryLocation>& where) {
                     : n_faces == 2 ? BoundaryLocation::Kind::FeatureEdge
                                    : BoundaryLocation::Kind::Corner;
   }
-  (void)moved;
   return m;
 }
 P3 cube_normal(const BoundaryLocation& w) {
@@ -229,8 +241,7 @@ TEST_CASE("edge contraction removes the node of a short edge", "[edge_removal]")
       const double vol = total_volume6(m), before = min_dihedral(m);
       const std::size_t n_nodes = m.points.size();
       REQUIRE(before < 10.0);
-      std::vector<std::int32_t> cell(m.solid.size());
-      for (std::size_t e = 0; e < cell.size(); ++e) cell[e] = static_cast<std::int32_t>(e);
+      std::vector<std::int32_t> cell = own_cells(m);
       EdgeRemovalOptions eo;
       eo.below_deg = 30.0;
       eo.surface_normal = cube_normal;
@@ -285,15 +296,7 @@ TEST_CASE("edge contraction removes the node of a short edge", "[edge_removal]")
 
 TEST_CASE("edge contraction inside a jittered cube keeps a valid mesh of the same volume", "[edge_removal][property]") {
   test::prop("jittered Kuhn cubes, contractions", 20, [](unsigned seed) {
-    Mesh<3> m = test::grid_mesh<3>(3, true);
-    std::uint64_t s = seed;
-    const auto rnd = [&] {
-      s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-      return double(s >> 11) / double(1ULL << 53) - 0.5;
-    };
-    for (P3& x : m.points)
-      if (x.minCoeff() > 0 && x.maxCoeff() < 3) x += 0.8 * P3(rnd(), rnd(), rnd());
-    for (std::size_t e = 0; e < m.solid.size(); ++e) RC_PRE(volume6(m, e) > 0);
+    Mesh<3> m = jittered_kuhn_grid(seed, 0.8);
     // Hull nodes are surface nodes without a normal: only inside nodes may go.
     std::vector<BoundaryLocation> where(m.points.size());
     for (const VertexId n : m.interface.node) where[n.v].patch = 0;
