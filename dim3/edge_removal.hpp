@@ -50,7 +50,7 @@ struct EdgeRemovalOptions {
   /// edge, and then only if the new interface triangles fit the surface (as for a surface swap:
   /// needs surface_normal). The mesh's nodes are renumbered (EdgeRemovalStats::node_map).
   double contract_below_deg = 0.0;
-  /// Per node: 1 = never contracted away (feature corners, nodes the optimiser keeps). Empty: none.
+  /// Per node: 1 = never contracted away (the pipeline: the feature corners). Empty: none.
   std::vector<std::uint8_t> keep;
   /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
   /// on one); the result is the same for every count.
@@ -73,9 +73,10 @@ struct EdgeRemovalStats {
 /// Removes edges of bad tetrahedra from `mesh` (all Tet4; interface all Tri3, outward) while a
 /// removal raises the worst angle around its edge, and contracts edges of those still under
 /// opt.contract_below_deg. `where` (per node, patch >= 0 on the surface) is read only; after a
-/// contraction it, like every per-node array, needs remap_nodes(stats.node_map, ...). Per-element arrays stay in step: mesh.level, mesh.from_boundary_cell and, if
-/// not null, `cell` (new tetrahedra take the values of the first tetrahedron they replace).
-/// Element order changes: survivors keep their order, new ones come last.
+/// contraction it, like every per-node array, needs remap_nodes(stats.node_map, ...).
+/// Per-element arrays stay in step: mesh.level, mesh.from_boundary_cell and, if not null,
+/// `cell` (new tetrahedra take the values of the first tetrahedron they replace). Element order
+/// changes: survivors keep their order, new ones come last.
 EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
                                   const EdgeRemovalOptions& opt);
 
