@@ -8,8 +8,8 @@
 # Usage: experiments/data_sweep3d.sh [BUILD_DIR] [OUT_DIR]
 #   LEVELS="4 5 6" KINDS="tet hex" SURFACES="sphere966 anchor" THREADS=1 narrow it down;
 #   KEEP=0 removes each run's folder once its row is printed (level 6 meshes are 0.1-1 GB);
-#   the exit status is 1 when any run is not valid (the regression test dim3_data_levels,
-#   tests/CMakeLists.txt, runs it at levels 4-6 in both kinds).
+#   the exit status is 1 when any run is not valid (the regression tests dim3_data_levels_SURFACE,
+#   tests/CMakeLists.txt, one per surface, run it at levels 4-6 in both kinds).
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 bin=${1:-$root/build}/febemesh
