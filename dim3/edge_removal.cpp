@@ -25,12 +25,6 @@ constexpr double none = -std::numeric_limits<double>::infinity();
 
 double orient(const P3& a, const P3& b, const P3& c, const P3& d) { return (b - a).dot((c - a).cross(d - a)); }
 
-/// The local nodes of a tetrahedron's edge e (0..5).
-std::pair<int, int> tet_edge(int e) {
-  static constexpr int ends[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  return {ends[e][0], ends[e][1]};
-}
-
 /// The mesh as removals edit it. The input's tetrahedra are read from the mesh where they are;
 /// those added live here; dead ones of either stay until the write-back, which compacts the
 /// mesh's arrays in place (sphere966 L6: a full copy of the tetrahedra, their qualities and
@@ -445,15 +439,14 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
     for (int i = 0; i < 4 && !done; ++i)
       for (int j = i + 1; j < 4 && !done; ++j) done = w.try_remove(nodes[i], nodes[j], st);
     if (!done && w.q(t) < contract_below) {
-      // Its edges, shortest first (ties in edge order); each way round.
-      std::array<std::pair<double, int>, 6> edges;
-      for (int e = 0; e < 6; ++e) {
-        const auto [i, j] = tet_edge(e);
-        edges[e] = {(mesh.points[nodes[i]] - mesh.points[nodes[j]]).squaredNorm(), e};
-      }
+      // Its edges, shortest first (ties in the order of the removal loop above); each way round.
+      std::array<std::pair<double, std::array<int, 2>>, 6> edges;
+      int e = 0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) edges[e++] = {(mesh.points[nodes[i]] - mesh.points[nodes[j]]).squaredNorm(), {i, j}};
       std::sort(edges.begin(), edges.end());
       for (int k = 0; k < 6 && !done; ++k) {
-        const auto [i, j] = tet_edge(edges[k].second);
+        const auto [i, j] = edges[k].second;
         done = w.try_contract(nodes[i], nodes[j], st) || w.try_contract(nodes[j], nodes[i], st);
       }
     }
