@@ -11,7 +11,7 @@
 //               far sheet of a part thinner than the octant, or a lip;
 //   long      - a projection longer than 1.5 face sizes;
 //   other     - all projections go out and land facing the face: shear between neighbours.
-// Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]
+// Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [options]  (--help lists them)
 // --pipeline runs the whole pipeline instead; with --quality it sorts the final mesh's tetrahedra
 // under 10 degrees (--below DEG) by where they come from (print_quality_diagnosis).
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
@@ -31,6 +31,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <vector>
 #include <algorithm>
 #include <array>
 #include <map>
@@ -140,12 +141,70 @@ void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int du
   }
 }
 
+constexpr const char* usage =
+    "usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [options]\n"
+    "  The first tree's boundary octants and raw tetrahedra, their inverted ones sorted by cause.\n"
+    "  THICKNESS_CELLS       the thickness level from the first tree (Options3d::thickness_cells)\n"
+    "first tree and projections:\n"
+    "  --dump N              print the first N folded octants   --only K   only cause K of them\n"
+    "  --near X Y Z R        with --dump: only octants within R of (X, Y, Z)\n"
+    "  --snap                snap to feature lines here too      --unfold   unfold backward projections\n"
+    "  --all                 outward test on all faces           --norays   no projection rays\n"
+    "  --outward C           BoundaryOctantOptions::min_outward  --facing C  min_facing\n"
+    "  --feature-extra L     the feature level above the global one (default 1)\n"
+    "  --feature-at-edges    the feature level at the feature edges only\n"
+    "  --opposing            drop interior octants at nodes with opposing free faces\n"
+    "  --thin-share          print the share of the surface thinner than 0.5-2 octants, and stop\n"
+    "whole pipeline:\n"
+    "  --pipeline            run mesh3d and print its verdict, tets, min dihedral, volume error\n"
+    "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin\n"
+    "  --single              one try, no fallbacks           --nosnap  no feature snapping\n"
+    "  --accept-folds --peel-rounds N --buffer B --max-repairs N --island-refinements N\n"
+    "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N\n"
+    "  --extra-levels N --thickness-extra N --optimize-sweeps N --target-dihedral DEG --smooth N\n"
+    "                        the Options3d fields of those names (dim3/pipeline3d.hpp)\n";
+
+/// The options and how many values each takes.
+int option_values(const std::string& a) {
+  static const std::vector<std::pair<std::string, int>> known = {
+      {"--accept-folds", 0}, {"--all", 0}, {"--feature-at-edges", 0}, {"--norays", 0}, {"--nosnap", 0},
+      {"--opposing", 0}, {"--pipeline", 0}, {"--quality", 0}, {"--single", 0}, {"--snap", 0},
+      {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--dump", 1},
+      {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
+      {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
+      {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
+      {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1}};
+  for (const auto& [name, n] : known)
+    if (a == name) return n;
+  return -1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--help" || std::string(argv[i]) == "-h") {
+      std::cout << usage;
+      return 0;
+    }
   if (argc < 3) {
-    std::cerr << "usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [--dump N]\n";
+    std::cerr << usage;
     return 2;
+  }
+  for (int i = 3; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--", 0) != 0) {
+      if (i == 3) continue;  // THICKNESS_CELLS
+      std::cerr << "diagnose3d: unexpected argument '" << a << "'\n" << usage;
+      return 2;
+    }
+    const int n = option_values(a);
+    if (n < 0 || i + n > argc - 1) {
+      std::cerr << "diagnose3d: " << (n < 0 ? "unknown option '" + a + "'" : a + " needs " + std::to_string(n) + " value(s)")
+                << "\n" << usage;
+      return 2;
+    }
+    i += n;
   }
   const std::string path = argv[1];
   const int level = std::atoi(argv[2]);
