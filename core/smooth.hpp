@@ -30,6 +30,12 @@ template <int Dim> struct SmoothOptions {
   bool boundary_fixed = false;
   /// Maps a point near the boundary onto it; when set, boundary nodes may slide.
   std::function<Point<Dim>(const Point<Dim>&)> project;
+  /// A node whose target lies within this share of its longest edge (max norm) of where it
+  /// stands stays there, as if the target were its position: on a grid the centroid of the
+  /// neighbours is the node itself up to rounding, and such moves (97% of the tries in the 2D
+  /// flange at 5.4 M triangles, under 1e-12 of the edge) change no quality beyond rounding but
+  /// each costs the guard and wakes the neighbours. 0 = every target that differs moves.
+  double min_move = 0.0;
   /// Threads for the sweeps (project must then be safe to call concurrently); the result is the
   /// same, bit for bit, for every count.
   int n_threads = 1;

@@ -101,6 +101,35 @@ TEMPLATE_TEST_CASE_SIG("smoothing improves a perturbed grid and keeps the bounda
   }
 }
 
+TEMPLATE_TEST_CASE_SIG("min_move: a target within rounding of the node is no move; real ones still are",
+                       "[smooth]", ((int Dim), Dim), 2, 3) {
+  for (const bool simplices : {false, true}) {
+    CAPTURE(simplices);
+    // A grid whose interior nodes are off their centroids by rounding only (1e-13 of a cell).
+    const Mesh<Dim> noisy = perturbed<Dim>(4, simplices, 1e-13, 5);
+    SmoothOptions<Dim> opt;
+    Mesh<Dim> plain = noisy;
+    const SmoothStats tried = smooth(plain, opt);
+    CHECK(tried.moves_accepted + tried.moves_rejected > 0);  // without it, every node is tried
+    opt.min_move = 1e-10;
+    Mesh<Dim> kept = noisy;
+    const SmoothStats none = smooth(kept, opt);
+    CHECK(none.moves_accepted == 0);
+    CHECK(none.moves_rejected == 0);
+    CHECK(kept.points == noisy.points);
+    // Real moves are made as before: the same points as without the threshold.
+    const Mesh<Dim> rough = perturbed<Dim>(4, simplices, 0.3, 7);
+    Mesh<Dim> with = rough, without = rough;
+    const SmoothStats sw = smooth(with, opt);
+    smooth(without, SmoothOptions<Dim>{});
+    CHECK(sw.moves_accepted > 0);
+    CHECK(min_quality(with) > min_quality(rough));
+    for (std::size_t i = 0; i < with.points.size(); ++i)
+      CHECK((with.points[i] - without.points[i]).cwiseAbs().maxCoeff() < 1e-9);
+    check_same_on_threads(rough, opt, with, sw);
+  }
+}
+
 TEMPLATE_TEST_CASE_SIG("fixed nodes do not move", "[smooth]", ((int Dim), Dim), 2, 3) {
   Mesh<Dim> mesh = perturbed<Dim>(3, true, 0.2, 3);
   const Mesh<Dim> before = mesh;
