@@ -56,7 +56,13 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   ro.n_threads = opt.n_threads;
 
   say("quadrant generation: subdividing by the mesh control parameters");
-  const ControlFn<2> control = [&](const Box<2>& b) { return curve.control_level(b); };
+  // A box outside the solid that meets no curve holds no element, whatever the level there:
+  // it is not split (the 2:1 balance grades the outside around the solid). The interior and
+  // curve quadrants, and so the mesh, are those of the uniform outside; the tree of a glyph
+  // was three quarters outside leaves (NimbusSans U0067 at level 11: 16.8 M, 4.3 M inside).
+  const ControlFn<2> control = [&](const Box<2>& b) {
+    return curve.classify(b) == Side::Out ? 0.0 : curve.control_level(b);
+  };
   Orthtree<2> tree = subdivide_by_control(curve.root_box(), control, ro);
   clock.lap("subdivide");
   if (opt.keep_stages) r.subdivided = tree;
