@@ -61,7 +61,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   // curve quadrants, and so the mesh, are those of the uniform outside; the tree of a glyph
   // was three quarters outside leaves (NimbusSans U0067 at level 11: 16.8 M, 4.3 M inside).
   const ControlFn<2> control = [&](const Box<2>& b) {
-    return curve.classify(b) == Side::Out ? 0.0 : curve.control_level(b);
+    return !opt.split_outside && curve.classify(b) == Side::Out ? 0.0 : curve.control_level(b);
   };
   Orthtree<2> tree = subdivide_by_control(curve.root_box(), control, ro);
   clock.lap("subdivide");

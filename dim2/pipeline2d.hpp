@@ -29,6 +29,9 @@ struct Options2d {
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
+  /// Split boxes outside the solid to the level field too (they hold no element; off: they stay
+  /// whole and the balance grades them, the same mesh from a smaller tree). For tests.
+  bool split_outside = false;
   int n_threads = 1;                 ///< threads for refinement, classification and smoothing; results do not depend on it
   bool keep_stages = true;           ///< keep the intermediate trees and complexes for figures
   /// Stages are dropped (and the unpulled complex is not rebuilt) when the mesh has more FE

@@ -117,6 +117,23 @@ TEST_CASE("pipeline is deterministic and its MSH reads back the same", "[propert
   tally.print("determinism");
 }
 
+TEST_CASE("leaving the outside unsplit gives the same mesh, from fewer quadrants", "[property][pipeline2d]") {
+  Tally tally;
+  test::prop("outside boxes unsplit: the same msh bytes", 4, [&] {
+    PipelineCase c = *test::gen_pipeline_case();
+    const test::PipelineOutcome pruned = run_case(c, tally);
+    CurveBoundary curve(test::to_domain(c.domain));
+    Options2d opt = test::to_options(c);
+    opt.split_outside = true;
+    if (opt.level != no_level) curve.set_global_level(opt.level);
+    const Result2d full = mesh2d(curve, opt);
+    RC_ASSERT(msh_string<2>(pruned.r.fe.mesh) == msh_string<2>(full.fe.mesh));
+    RC_ASSERT(pruned.r.tree.n_leaves() <= full.tree.n_leaves());
+    RC_TAG(pruned.r.tree.n_leaves() < full.tree.n_leaves() ? "fewer quadrants" : "as many quadrants");
+  });
+  tally.print("outside unsplit");
+}
+
 TEST_CASE("the FE area approaches the exact area as the level rises", "[property][pipeline2d]") {
   Tally tally;
   test::prop("BE distance to the curve falls over two levels and bounds the area error", 4, [&] {
