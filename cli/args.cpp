@@ -1,12 +1,23 @@
 #include "cli/args.hpp"
 
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 
 #include "cli/command.hpp"
 
 namespace febemesh::cli {
+namespace {
+
+/// x as the shortest text that reads back as x ("28", "0.5", "1e+30").
+std::string shortest(double x) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
+}
+
+}  // namespace
 
 Args::Args(const std::vector<std::string>& argv, std::set<std::string> flags, std::set<std::string> valued) {
   for (std::size_t i = 0; i < argv.size(); ++i) {
@@ -67,8 +78,8 @@ double Args::real_or(const std::string& opt, double fallback, double lo, double 
   char* end = nullptr;
   double x = std::strtod(v->c_str(), &end);
   if (v->empty() || *end != '\0' || !std::isfinite(x) || x < lo || x > hi)
-    throw UsageError("option " + opt + " expects a number in [" + std::to_string(lo) + ", " +
-                     std::to_string(hi) + "], got '" + *v + "'");
+    throw UsageError("option " + opt + " expects a number in [" + shortest(lo) + ", " + shortest(hi) + "], got '" +
+                     *v + "'");
   return x;
 }
 

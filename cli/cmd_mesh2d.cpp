@@ -116,11 +116,16 @@ int run(const std::vector<std::string>& argv) {
     if (!quiet) std::cerr << "mesh2d: " << s << "\n";
   };
   progress("reading " + input);
+  RunInfo info;
+  const auto since = [](std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   Domain domain = read_domain(input);
   CurveBoundary curve(std::move(domain));
   if (opt.level != no_level) curve.set_global_level(opt.level);
   curve.set_max_level(opt.max_level);
   check_budget(curve, opt.level != no_level ? opt.level : curve.global_level(), opt.max_cells);
+  info.steps.push_back({"read", since(start)});
 
   Result2d r = mesh2d(curve, opt, progress);
 
@@ -130,11 +135,16 @@ int run(const std::vector<std::string>& argv) {
   // one thread): the two writers were 1.21 G of the CLI's 6.18 G instructions.
   progress("writing " + out);
   AtomicOutputDir dir(out);
+  double t_write = 0.0;
   std::future<void> writing = std::async(opt.n_threads > 1 ? std::launch::async : std::launch::deferred, [&] {
+    const auto t0 = std::chrono::steady_clock::now();
     write_msh<2>(r.fe.mesh, dir.file("mesh.msh"), encoding);
     write_vtu<2>(r.fe.mesh, dir.file("mesh.vtu"));
+    t_write = since(t0);
   });
+  auto t0 = std::chrono::steady_clock::now();
   const Fidelity2d fid = measure_fidelity(r.fe, curve);
+  info.steps.push_back({"fidelity", since(t0)});
 
   ValidationReport valid;
   if (!args.has("--no-validate")) {
@@ -145,15 +155,17 @@ int run(const std::vector<std::string>& argv) {
     vo.boundary_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
     vo.boundary_tolerance = 1e-10 * (bb.hi - bb.lo).norm();
     vo.n_threads = opt.n_threads;
+    t0 = std::chrono::steady_clock::now();
     valid = validate<2>(r.fe.mesh, vo);
+    info.steps.push_back({"validation", since(t0)});
   }
   if (!valid.valid && !args.has("--no-validate"))
     throw std::runtime_error("the mesh of " + input + " failed validation (please report):\n" + valid.summary());
   writing.get();  // rethrows a write error (one thread: writes now)
+  info.steps.push_back({"write mesh.msh and mesh.vtu", t_write});  // beside the checks on 2+ threads
   if (r.stages_kept) write_stage_figures(r, curve, dir.file("figures"));
   else if (opt.keep_stages) write_figures_skipped_note(dir.file("figures"), r.fe.mesh.solid.size(), opt.keep_stages_max_elements);
   if (opt.keep_stages) draw_geometry_figure(curve, dir.file("figures") / "00-geometry.svg");
-  RunInfo info;
   info.input = input;
   info.version = FEBEMESH_VERSION;
   info.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -105,6 +105,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
 
   ordered_json times;
   for (const StageTime& t : r.times) times[t.name] = t.seconds;
+  for (const StageTime& t : info.steps) times[t.name] = t.seconds;
   times["total"] = info.total_seconds;
   j["timings_seconds"] = times;
   j["peak_memory_bytes"] = info.peak_memory_bytes;

@@ -3,7 +3,9 @@
 // scaled-Jacobian histogram), fidelity against the exact curve, validation, and the options.
 
 #include <string>
+#include <vector>
 
+#include "core/stage_timer.hpp"
 #include "core/validate.hpp"
 #include "dim2/fidelity2d.hpp"
 #include "dim2/pipeline2d.hpp"
@@ -15,6 +17,9 @@ struct RunInfo {
   std::string version;
   double total_seconds = 0.0;
   long peak_memory_bytes = 0;
+  /// The caller's own steps around mesh2d (reading, writing, checking), in the report's
+  /// timings after the pipeline's stages.
+  std::vector<StageTime> steps;
 };
 
 /// The report as pretty-printed JSON. Deterministic apart from the timing and memory fields.

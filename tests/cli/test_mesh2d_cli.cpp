@@ -1,0 +1,123 @@
+// `febemesh mesh2d` as users and scripts call it (DESIGN.md contracts): the output folder's
+// files and what they hold, the report's counts and timings, the same mesh.msh on any thread
+// count, and the exit statuses: 1 for bad input (one message naming the file, no folder left
+// behind), 2 for bad usage.
+
+#include <catch2/catch.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/read_msh.hpp"
+#include "core/validate.hpp"
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string output;  ///< stdout and stderr
+};
+
+Run run(const std::string& args) {
+  const std::string cmd = std::string("'") + FEBEMESH_CLI + "' " + args + " 2>&1";
+  Run r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) r.output.append(buf, n);
+  const int st = pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::filesystem::path scratch(const std::string& name) {
+  return std::filesystem::temp_directory_path() / ("febemesh_mesh2d_cli_" + name + "_" + std::to_string(::getpid()));
+}
+
+const std::string flange = std::string(FEBEMESH_SOURCE_DIR) + "/examples/flange.json";
+
+}  // namespace
+
+TEST_CASE("mesh2d writes mesh.msh, mesh.vtu and a report whose counts are the mesh's", "[cli][mesh2d]") {
+  const auto dir = scratch("outputs");
+  std::filesystem::remove_all(dir);
+  const Run r = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 6 --threads 1 --quiet");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  CHECK(r.output == dir.string() + "\n");  // --quiet: only the folder, on stdout (for scripts)
+  for (const char* f : {"mesh.msh", "mesh.vtu", "report.json"}) CHECK(std::filesystem::file_size(dir / f) > 100);
+  const febemesh::Mesh<2> m = febemesh::read_msh<2>(dir / "mesh.msh");
+  CHECK(febemesh::is_valid(m));
+  const auto rep = nlohmann::json::parse(read_text(dir / "report.json"));
+  CHECK(rep["counts"]["fe_elements"] == m.solid.size());
+  CHECK(rep["counts"]["be_elements"] == m.interface.size());
+  CHECK(rep["counts"]["nodes"] == m.points.size());
+  CHECK(rep["validation"]["valid"] == true);
+  // The pipeline's stages and the CLI's own steps, each a time, none over the total.
+  const auto& t = rep["timings_seconds"];
+  for (const char* step : {"subdivide", "smoothing", "read", "fidelity", "validation", "write mesh.msh and mesh.vtu"}) {
+    INFO(step);
+    REQUIRE(t.contains(step));
+    CHECK(t[step].get<double>() >= 0.0);
+    CHECK(t[step].get<double>() <= t["total"].get<double>());
+  }
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") {
+  const auto dir = scratch("threads");
+  for (const char* n : {"1", "2"})
+    REQUIRE(run("mesh2d '" + flange + "' -o '" + (dir / n).string() + "' --level 7 --quiet --threads " + n).status == 0);
+  const std::string one = read_text(dir / "1" / "mesh.msh"), two = read_text(dir / "2" / "mesh.msh");
+  CHECK(one.size() > 10000);
+  CHECK(one == two);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("mesh2d refuses bad input with exit 1, one message naming the file, and no folder", "[cli][mesh2d]") {
+  const auto dir = scratch("bad");
+  std::filesystem::remove_all(dir);
+  for (const std::string& input : {std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/malformed.json",
+                                   std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/open_chain.poly",
+                                   std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/nan_path.svg",
+                                   dir.string() + "-missing.json"}) {
+    const Run r = run("mesh2d '" + input + "' -o '" + dir.string() + "' --quiet");
+    INFO(input << "\n" << r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find("error: " + input) != std::string::npos);
+    CHECK(r.output.find('\n') == r.output.size() - 1);  // one line
+    CHECK(!std::filesystem::exists(dir));
+  }
+}
+
+TEST_CASE("mesh2d refuses bad usage with exit 2 and points to --help", "[cli][mesh2d]") {
+  const auto dir = scratch("usage");
+  std::filesystem::remove_all(dir);
+  const std::string in = "mesh2d '" + flange + "'";
+  for (const std::string& args : {in, in + " -o '" + dir.string() + "' --bogus",
+                                  in + " -o '" + dir.string() + "' --elements hex",
+                                  in + " -o '" + dir.string() + "' --level 30",
+                                  in + " -o '" + dir.string() + "' --threads 0"}) {
+    const Run r = run(args);
+    INFO(args << "\n" << r.output);
+    CHECK(r.status == 2);
+    CHECK(r.output.find("--help") != std::string::npos);
+    CHECK(!std::filesystem::exists(dir));
+  }
+  const Run help = run("mesh2d --help");
+  CHECK(help.status == 0);
+  for (const char* opt : {"--level", "--elements", "--threads", "--binary", "exit status"})
+    CHECK(help.output.find(opt) != std::string::npos);
+}
