@@ -101,6 +101,19 @@ TEST_CASE("valid smooth loops with corners pass", "[checks]") {
   CHECK(message_of(domain_of({sharp})).empty());
 }
 
+TEST_CASE("a long leaning spike: refused where its sides come within the tolerance, else valid", "[checks]") {
+  // A fuzzed .poly (tests/fuzz/regressions/poly/thin-spike-timeout.poly): sides 7.8e9 long,
+  // 11 apart at the base, meeting at the tip at an angle of ~1e-9 rad, so they run within the
+  // tolerance (1e-10 of the size) of each other over the last tenth: a touch.
+  const Loop thin = loop_from_polygon({P2(2, 10), P2(22221104, 7771111777), P2(8, 0), P2(4, 0)}, "thin");
+  const std::string msg = message_of(domain_of({thin}));
+  CHECK(msg.find("intersects itself") != std::string::npos);
+  // The same spike 1e5 wide at the base (tip angle ~1.3e-5 rad): only the pieces at the tip
+  // come within the tolerance, and they meet at their junction: the loop is valid.
+  const Loop wide = loop_from_polygon({P2(2, 100000), P2(22221104, 7771111777), P2(8, 0), P2(4, 0)}, "wide");
+  CHECK(message_of(domain_of({wide})).empty());
+}
+
 TEST_CASE("self-intersection of random polygons agrees with the polyline twin", "[checks][property]") {
   febemesh::test::prop("fast == polyline reference", 300, [] {
     const int n = *rc::gen::inRange(3, 8);
