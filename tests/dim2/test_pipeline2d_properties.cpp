@@ -155,8 +155,12 @@ TEST_CASE("the FE area approaches the exact area as the level rises", "[property
       err.push_back(out.f.area_rel_error);
       haus.push_back(out.f.hausdorff);
       // The region between the BE polygon and the curve lies within the Hausdorff distance of
-      // the curve: |FE area - exact area| <= perimeter x Hausdorff (1% margin for sampling).
-      RC_ASSERT(out.f.area_rel_error * out.f.exact_area <= 1.01 * perimeter * out.f.hausdorff);
+      // the curve: |FE area - exact area| <= perimeter x Hausdorff (1% margin for sampling),
+      // plus the FE area's round-off (check_valid's: a polygonal domain has Hausdorff ~1e-16
+      // and an area error of round-off only; seed 2112, case 701: 2.6e-14 of the area).
+      const double round_off = 4.0 * std::numeric_limits<double>::epsilon() * double(out.v.n_solid);
+      RC_ASSERT(out.f.area_rel_error * out.f.exact_area <=
+                1.01 * perimeter * out.f.hausdorff + round_off * out.f.exact_area);
       ++c.domain.level;
     }
     RC_LOG() << "area errors " << err[0] << " " << err[1] << " " << err[2] << ", Hausdorff " << haus[0] << " "
@@ -170,8 +174,10 @@ TEST_CASE("the FE area approaches the exact area as the level rises", "[property
     // cells of level 9 or finer at its bends, Hausdorff 8.67487e-5 at levels 6, 7 and 8, then
     // 2.63e-5 at 9).
     RC_LOG() << "finest leaf level " << finest << " at level " << level0 << "\n";
-    RC_ASSERT(haus[2] <= haus[0]);
-    if (finest < level0 + 2) RC_ASSERT(haus[2] < haus[0]);
+    // Distances at round-off (a polygonal domain's BE polygon is its boundary) do not count.
+    const double noise = 1e-12 * perimeter;
+    RC_ASSERT(haus[2] <= haus[0] + noise);
+    if (finest < level0 + 2 && haus[0] > noise) RC_ASSERT(haus[2] < haus[0]);
   });
   tally.print("area convergence");
 }
