@@ -278,13 +278,6 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     std::size_t accepted = 0, rejected = 0;
   };
   std::vector<PerThread> per_thread(static_cast<std::size_t>(sweep.n_threads()));
-  // Whether target is within min_move of v's longest edge (max norm) of where v stands.
-  const auto rounding_move = [&](std::int32_t v, std::span<const std::int32_t> nbrs, const Point<Dim>& target) {
-    const Point<Dim>& p = mesh.points[v];
-    double edge = 0;
-    for (const auto w : nbrs) edge = std::max(edge, (mesh.points[w] - p).cwiseAbs().maxCoeff());
-    return (target - p).cwiseAbs().maxCoeff() <= options.min_move * edge;
-  };
   const auto visit = [&](std::int32_t v, int t) {
     PerThread& my = per_thread[static_cast<std::size_t>(t)];
     if (settled[v]) {
@@ -298,7 +291,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     for (const auto w : nbrs) target += mesh.points[w];
     target /= static_cast<double>(nbrs.size());
     if (slides) target = options.project(target);
-    if (target == mesh.points[v] || (options.min_move > 0 && rounding_move(v, nbrs, target))) {
+    if (target == mesh.points[v] || (options.min_move > 0 && within_rounding<Dim>(mesh.points, v, nbrs, target, options.min_move))) {
       settled[v] = 1;
       return;
     }

@@ -6,9 +6,11 @@
 // facets of the solid) stay put unless `project` is given: then they move to the centroid of
 // their neighbours along the boundary and are projected back, under the same guard.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -48,6 +50,17 @@ struct SmoothStats {
   double min_quality_before = 0.0;  ///< min scaled Jacobian of the solid elements
   double min_quality_after = 0.0;
 };
+
+/// Whether `target` lies within `share` of node v's longest edge to `nbrs` (max norm) of where v
+/// stands: a move of rounding size (SmoothOptions::min_move; the 2D quality pass too).
+template <int Dim>
+bool within_rounding(const std::vector<Point<Dim>>& points, std::int32_t v, std::span<const std::int32_t> nbrs,
+                     const Point<Dim>& target, double share) {
+  const Point<Dim>& p = points[static_cast<std::size_t>(v)];
+  double edge = 0;
+  for (const std::int32_t w : nbrs) edge = std::max(edge, (points[static_cast<std::size_t>(w)] - p).cwiseAbs().maxCoeff());
+  return (target - p).cwiseAbs().maxCoeff() <= share * edge;
+}
 
 /// Moves mesh.points in place; the connectivity is unchanged.
 template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>& options = {});

@@ -10,23 +10,19 @@
 #include "core/guard_order.hpp"
 #include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
+#include "core/smooth.hpp"
 
 namespace febemesh::dim2 {
 namespace {
 
 using P2 = Point<2>;
 
-/// Whether the guarded smoothing's target for node v (neighbours nb) is where v stands up to
-/// rounding: within 1e-10 of v's longest edge to nb (max norm). On a grid the centroid is the
-/// node itself but for a few ulps (1e-13 of an edge at level 10, 3e-11 at level 17); trying it
-/// cost the guard three steps at most of the nodes (flange, 5.4 M triangles). Such a node stays
-/// (it could at best gain ~1e-8 deg). The same test in improve_mesh and improve_mesh_ref.
-bool rounding_target(const Mesh<2>& m, std::size_t v, std::span<const std::int32_t> nb, const P2& target) {
-  const P2& p = m.points[v];
-  double edge = 0;
-  for (const std::int32_t w : nb) edge = std::max(edge, (m.points[static_cast<std::size_t>(w)] - p).cwiseAbs().maxCoeff());
-  return (target - p).cwiseAbs().maxCoeff() <= 1e-10 * edge;
-}
+/// The quality pass's rounding share: a target within 1e-10 of v's longest edge from v is where v
+/// stands up to rounding (within_rounding). On a grid the centroid is the node itself but for a
+/// few ulps (1e-13 of an edge at level 10, 3e-11 at level 17); trying it cost the guard three
+/// steps at most of the nodes (flange, 5.4 M triangles). Such a node stays (it could at best
+/// gain ~1e-8 deg). The same test in improve_mesh and improve_mesh_ref.
+constexpr double rounding_share = 1e-10;
 
 double cross(const P2& a, const P2& b, const P2& c) {
   return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
@@ -479,7 +475,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       P2 target = P2::Zero();
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
-      if (rounding_target(m, v, nb, target)) {
+      if (within_rounding<2>(m.points, static_cast<std::int32_t>(v), nb, target, rounding_share)) {
         settled[v] = 1;  // the same numbers until a node of its elements moves
         continue;
       }
@@ -669,7 +665,7 @@ ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locke
       P2 target = P2::Zero();
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
-      if (rounding_target(m, v, nb, target)) continue;
+      if (within_rounding<2>(m.points, static_cast<std::int32_t>(v), nb, target, rounding_share)) continue;
       auto local_min = [&] {
         double q = 180.0;
         for (std::int32_t e : incident[v]) q = std::min(q, min_corner_angle_deg(m, e));
