@@ -65,10 +65,12 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   };
   Orthtree<2> tree = subdivide_by_control(curve.root_box(), control, ro);
   clock.lap("subdivide");
+  r.n_subdivided = tree.n_leaves();
   if (opt.keep_stages) r.subdivided = tree;
   say("quadrant generation: " + std::to_string(tree.n_leaves()) + " quadrants; one-level-difference rule");
   tree = balance_2to1(tree, BalanceKind::Face);
   clock.lap("balance");
+  r.n_balanced = tree.n_leaves();
   if (opt.keep_stages) r.balanced = tree;
 
   const CurveMidpoint midpoint = [&](const BoundaryLocation& a, const BoundaryLocation& b) {
@@ -99,6 +101,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     BoundaryQuadrantOptions bo;
     bo.corners_may_fail = last;
     QuadrantComplexResult bq = build_quadrant_complex(tree, in, curve, bo, &edges);
+    r.n_boundary_quadrants = bq.complex.boundary.size();
     clock.lap("boundary quadrants");
     std::vector<Problem> problems = bq.problems;
 
@@ -107,7 +110,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       say("finite elements: templates");
       // Quad = the mixed mesh smoothed and improved, then split once and optimised.
       const ElementKind base = opt.elements == ElementKind::Quad ? ElementKind::Mixed : opt.elements;
-      fe = fe_be_mesh(bq.complex, base, midpoint);
+      fe = fe_be_mesh(bq.complex, base, midpoint, opt.n_threads);
       // The complex is kept only for the figures (and the quad split only adds elements): free
       // it before smoothing, the run's memory peak, when they will not be drawn.
       if (!opt.keep_stages || fe.mesh.solid.size() > opt.keep_stages_max_elements) bq.complex = QuadrantComplex();

@@ -51,6 +51,10 @@ struct Result2d {
   // Result.
   FeBeMesh fe;                      ///< smoothed FE mesh + BE mesh
   BoundaryQuadrantStats stats;
+  // Counts of the stages, kept or not (report.json).
+  std::size_t n_subdivided = 0;          ///< leaves after the subdivision
+  std::size_t n_balanced = 0;            ///< leaves after the first 2:1 balance
+  std::size_t n_boundary_quadrants = 0;  ///< of the complex the mesh was made from
   std::size_t n_buffer_dropped = 0;
   std::size_t n_pinches_dropped = 0;
   int n_repairs = 0;

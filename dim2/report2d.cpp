@@ -27,11 +27,11 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   counts["triangles"] = n_tri;
   counts["quadrilaterals"] = n_quad;
   counts["be_elements"] = m.interface.size();
-  counts["quadrants_subdivided"] = r.subdivided.n_leaves();
-  counts["quadrants_balanced"] = r.balanced.n_leaves();
+  counts["quadrants_subdivided"] = r.n_subdivided;
+  counts["quadrants_balanced"] = r.n_balanced;
   counts["quadrants_final"] = r.tree.n_leaves();
   counts["interior_quadrants"] = n_in;
-  counts["boundary_quadrants"] = r.complex.boundary.size();
+  counts["boundary_quadrants"] = r.n_boundary_quadrants;
   counts["loops"] = curve.n_loops();
   counts["components"] = curve.n_components();
   counts["holes"] = curve.n_holes();

@@ -76,6 +76,28 @@ TEST_CASE("mesh2d writes mesh.msh, mesh.vtu and a report whose counts are the me
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("mesh2d's report counts the stages whether or not it kept them for the figures", "[cli][mesh2d]") {
+  // Without figures the trees and the complex are dropped as soon as they are used (memory);
+  // the report counted them from the dropped copies: 1 leaf, 0 boundary quadrants.
+  const auto dir = scratch("counts");
+  std::filesystem::remove_all(dir);
+  for (const char* figures : {"auto", "none"})
+    REQUIRE(run("mesh2d '" + flange + "' -o '" + (dir / figures).string() + "' --level 6 --quiet --figures " + figures).status == 0);
+  const auto kept = nlohmann::json::parse(read_text(dir / "auto" / "report.json"));
+  const auto dropped = nlohmann::json::parse(read_text(dir / "none" / "report.json"));
+  CHECK(std::filesystem::exists(dir / "auto" / "figures"));
+  CHECK(kept["counts"] == dropped["counts"]);
+  const auto& c = dropped["counts"];
+  CHECK(c["quadrants_subdivided"].get<std::size_t>() > 100);
+  CHECK(c["quadrants_balanced"].get<std::size_t>() >= c["quadrants_subdivided"].get<std::size_t>());
+  CHECK(c["quadrants_final"].get<std::size_t>() >= c["quadrants_balanced"].get<std::size_t>());
+  CHECK(c["interior_quadrants"].get<std::size_t>() > 0);
+  // One boundary quadrant a free edge of the interior quadrants.
+  CHECK(c["boundary_quadrants"] == dropped["boundary_quadrants"]["free_edges"]);
+  CHECK(c["boundary_quadrants"].get<std::size_t>() > 0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") {
   const auto dir = scratch("threads");
   for (const char* n : {"1", "2"})
