@@ -9,19 +9,15 @@
 #include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
 #include "core/orthtree.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh {
 
 namespace {
 
-/// Sorts [first, last) ascending: in-place MSD radix sort (American flag) on the byte at `shift`
-/// and below, short ranges by std::sort. Linear in practice and no scratch buffer (this runs at
-/// the boundary stage's memory peak).
-void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
-  if (last - first < 64 || shift < 0) {
-    std::sort(first, last);
-    return;
-  }
+/// Orders [first, last) by the byte at `shift` in place (one pass of an American flag sort) and
+/// returns where each of the 256 buckets starts (start[256] = last - first).
+std::array<std::size_t, 257> partition_by_byte(std::uint64_t* first, std::uint64_t* last, int shift) {
   auto digit = [shift](std::uint64_t k) { return static_cast<std::size_t>((k >> shift) & 0xffu); };
   std::array<std::size_t, 257> start{};
   for (const std::uint64_t* p = first; p != last; ++p) ++start[digit(*p) + 1];
@@ -35,16 +31,45 @@ void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
       first[head[b]++] = v;
     }
   }
+  return start;
+}
+
+/// Sorts [first, last) ascending: in-place MSD radix sort on the byte at `shift` and below,
+/// short ranges by std::sort. Linear in practice and no scratch buffer (this runs at the
+/// boundary stage's memory peak).
+void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
+  if (last - first < 64 || shift < 0) {
+    std::sort(first, last);
+    return;
+  }
+  const auto start = partition_by_byte(first, last, shift);
   for (std::size_t b = 0; b < 256; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
 }
 
-/// Sorts `keys` ascending, starting at the highest byte in which they differ.
-void radix_sort(std::vector<std::uint64_t>& keys) {
+/// Sorts `keys` ascending, starting at the highest byte in which they differ. On several
+/// threads the first byte's pass runs on the caller and its buckets spread over the threads
+/// (a sort: the same keys for every count).
+void radix_sort(std::vector<std::uint64_t>& keys, int n_threads) {
   std::uint64_t any = 0, all = ~std::uint64_t{0};
   for (const std::uint64_t k : keys) any |= k, all &= k;
   int shift = 56;
   while (shift > 0 && (((any ^ all) >> shift) & 0xffu) == 0) shift -= 8;
-  radix_sort(keys.data(), keys.data() + keys.size(), shift);
+  std::uint64_t* const first = keys.data();
+  if (n_threads <= 1 || keys.size() < (std::size_t(1) << 16)) {
+    radix_sort(first, first + keys.size(), shift);
+    return;
+  }
+  const auto start = partition_by_byte(first, first + keys.size(), shift);
+  // The buckets in runs of about equal numbers of keys (buckets are uneven: a tree's corners
+  // crowd where it is fine), four runs a thread.
+  const std::size_t n_parts = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 64));
+  std::vector<std::size_t> part_first(n_parts + 1, 256);
+  for (std::size_t p = 0; p < n_parts; ++p)
+    part_first[p] = static_cast<std::size_t>(
+        std::lower_bound(start.begin(), start.begin() + 256, p * keys.size() / n_parts) - start.begin());
+  for_each_range(n_parts, n_threads, [&](std::size_t p0, std::size_t p1) {
+    for (std::size_t b = part_first[p0]; b < part_first[p1]; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
+  });
 }
 
 }  // namespace
@@ -94,10 +119,11 @@ template <int Dim> std::int32_t LatticeNodes<Dim>::find(const LatticePoint<Dim>&
 }
 
 template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep) {
-  return lattice_nodes(t, keep, HangingFlags::Computed);
+  return lattice_nodes(t, keep, HangingFlags::Computed, 1);
 }
 
-template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, HangingFlags hanging) {
+template <int Dim>
+LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, HangingFlags hanging, int n_threads) {
   if (keep != nullptr && keep->size() != t.n_leaves()) {
     throw InputError("lattice_nodes: keep mask has " + std::to_string(keep->size()) + " entries for " +
                      std::to_string(t.n_leaves()) + " leaves");
@@ -105,13 +131,28 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
   const auto kept = [&](std::size_t i) { return keep == nullptr || (*keep)[i] != 0; };
   constexpr int n_corners = Cube<Dim>::n_corners;
 
+  // Every kept leaf's corner keys, in leaf order: each run of leaves writes at its count of
+  // kept leaves before it.
+  const std::size_t n_leaves = t.n_leaves();
+  const std::size_t n_chunks = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
+  const std::size_t run = std::max<std::size_t>(std::size_t(1) << 14, (n_leaves + n_chunks - 1) / n_chunks);
+  const std::size_t n_runs = (n_leaves + run - 1) / run;
+  std::vector<std::size_t> run_start(n_runs + 1, 0);
+  for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) run_start[c + 1] += kept(i) ? 1 : 0;
+  });
+  for (std::size_t c = 0; c < n_runs; ++c) run_start[c + 1] += run_start[c];
   std::vector<std::uint64_t> keys;
   reserve_huge(keys, t.n_leaves() * n_corners);
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
-    if (!kept(i)) continue;
-    for (const std::uint64_t key : corner_keys(t.leaf(i))) keys.push_back(key);
-  }
-  radix_sort(keys);
+  keys.resize(run_start[n_runs] * n_corners);
+  for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    std::uint64_t* out = keys.data() + run_start[c] * n_corners;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!kept(i)) continue;
+      for (const std::uint64_t key : corner_keys(t.leaf(i))) *out++ = key;
+    }
+  });
+  radix_sort(keys, n_threads);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
     throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
@@ -119,50 +160,58 @@ template <int Dim> LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const
 
   LatticeNodes<Dim> nodes;
   reserve_huge(nodes.points, keys.size());
-  for (const std::uint64_t k : keys) nodes.points.push_back(point_from_key<Dim>(k));
+  nodes.points.resize(keys.size());
+  for_each_range(keys.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) nodes.points[n] = point_from_key<Dim>(keys[n]);
+  });
 
   reserve_huge(nodes.leaf_corners, t.n_leaves());
   nodes.leaf_corners.resize(t.n_leaves());
-  std::array<std::size_t, n_corners> near{};  // corner k's answer for the previous kept leaf
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
-    auto& row = nodes.leaf_corners[i];
-    if (!kept(i)) {
-      row.fill(-1);
-      continue;
+  for_each_range(n_leaves, n_threads, [&](std::size_t begin, std::size_t end) {
+    // Corner k's answer for the previous kept leaf: a hint only (the same answers from any).
+    std::array<std::size_t, n_corners> near{};
+    for (std::size_t i = begin; i < end; ++i) {
+      auto& row = nodes.leaf_corners[i];
+      if (!kept(i)) {
+        row.fill(-1);
+        continue;
+      }
+      const auto corner_key = corner_keys(t.leaf(i));
+      for (int k = 0; k < n_corners; ++k) {
+        near[k] = lower_bound_from(keys, corner_key[k], near[k]);
+        row[k] = std::int32_t(near[k]);
+      }
     }
-    const auto corner_key = corner_keys(t.leaf(i));
-    for (int k = 0; k < n_corners; ++k) {
-      near[k] = lower_bound_from(keys, corner_key[k], near[k]);
-      row[k] = std::int32_t(near[k]);
-    }
-  }
+  });
 
   if (hanging == HangingFlags::Skipped) return nodes;
   // The leaves touching node p are those containing the 2^Dim finest lattice cells around p.
   const LeafKeys<Dim> leaf_keys(t);
   // Nodes come in Morton order, so each of the 2^Dim cells around them moves little in the
   // leaves' Morton order from one node to the next: its search starts at its previous answer.
-  std::array<std::size_t, n_corners> hint{};
   nodes.hanging.assign(keys.size(), 0);
-  for (std::size_t n = 0; n < nodes.points.size(); ++n) {
-    const LatticePoint<Dim>& p = nodes.points[n];
-    for (int o = 0; o < n_corners && !nodes.hanging[n]; ++o) {
-      LatticePoint<Dim> q = p;
-      bool inside = true;
-      for (int d = 0; d < Dim; ++d) {
-        if (corner_is_upper(o, d)) {
-          inside = inside && q[d] < root_length<Dim>;
-        } else {
-          inside = inside && q[d] > 0;
-          q[d] -= inside ? 1 : 0;
+  for_each_range(nodes.points.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    std::array<std::size_t, n_corners> hint{};  // hints only: the same leaves from any
+    for (std::size_t n = begin; n < end; ++n) {
+      const LatticePoint<Dim>& p = nodes.points[n];
+      for (int o = 0; o < n_corners && !nodes.hanging[n]; ++o) {
+        LatticePoint<Dim> q = p;
+        bool inside = true;
+        for (int d = 0; d < Dim; ++d) {
+          if (corner_is_upper(o, d)) {
+            inside = inside && q[d] < root_length<Dim>;
+          } else {
+            inside = inside && q[d] > 0;
+            q[d] -= inside ? 1 : 0;
+          }
         }
+        if (!inside) continue;
+        const std::size_t j = leaf_keys.locate_near(q, hint[o]);
+        if (j != no_leaf) hint[o] = j;
+        if (j != no_leaf && kept(j) && !is_corner(t.leaf(j), p)) nodes.hanging[n] = 1;
       }
-      if (!inside) continue;
-      const std::size_t j = leaf_keys.locate_near(q, hint[o]);
-      if (j != no_leaf) hint[o] = j;
-      if (j != no_leaf && kept(j) && !is_corner(t.leaf(j), p)) nodes.hanging[n] = 1;
     }
-  }
+  });
   return nodes;
 }
 
@@ -170,7 +219,7 @@ template struct LatticeNodes<2>;
 template struct LatticeNodes<3>;
 template LatticeNodes<2> lattice_nodes<2>(const Orthtree<2>&, const Flags*);
 template LatticeNodes<3> lattice_nodes<3>(const Orthtree<3>&, const Flags*);
-template LatticeNodes<2> lattice_nodes<2>(const Orthtree<2>&, const Flags*, HangingFlags);
-template LatticeNodes<3> lattice_nodes<3>(const Orthtree<3>&, const Flags*, HangingFlags);
+template LatticeNodes<2> lattice_nodes<2>(const Orthtree<2>&, const Flags*, HangingFlags, int);
+template LatticeNodes<3> lattice_nodes<3>(const Orthtree<3>&, const Flags*, HangingFlags, int);
 
 }  // namespace febemesh

@@ -267,7 +267,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     if ((slides ? boundary_neighbours.of(id) : neighbours.of(id)).empty() || incident.of(id).empty()) continue;
     movable.push_back(id);
   }
-  const OrderedSweep sweep(std::move(movable), n, options.n_threads, [&](std::int32_t v, auto&& visit) {
+  const int sweep_threads = options.sweep_threads > 0 ? options.sweep_threads : options.n_threads;
+  const OrderedSweep sweep(std::move(movable), n, sweep_threads, [&](std::int32_t v, auto&& visit) {
     for (const std::int32_t e : incident.of(v)) {
       const VertexId* ev = mesh.solid.nodes(ElemId{e});
       for (int j = 0; j < mesh.solid.n_nodes_of(ElemId{e}); ++j) visit(ev[j].v);

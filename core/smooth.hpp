@@ -38,9 +38,12 @@ template <int Dim> struct SmoothOptions {
   /// flange at 5.4 M triangles, under 1e-12 of the edge) change no quality beyond rounding but
   /// each costs the guard and wakes the neighbours. 0 = every target that differs moves.
   double min_move = 0.0;
-  /// Threads for the sweeps (project must then be safe to call concurrently); the result is the
-  /// same, bit for bit, for every count.
+  /// Threads for the neighbour lists, the element states and the sweeps (project must then be
+  /// safe to call concurrently); the result is the same, bit for bit, for every count.
   int n_threads = 1;
+  /// Threads for the in-order sweeps alone, when > 0 (else n_threads): where a visit costs
+  /// less than scheduling it on the sweep's DAG (the 2D pipeline), the sweeps run serially.
+  int sweep_threads = 0;
 };
 
 struct SmoothStats {

@@ -13,6 +13,7 @@
 #include "core/free_facets.hpp"
 #include "core/huge_pages.hpp"
 #include "core/lattice_nodes.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -207,7 +208,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
                                              const BoundaryQuadrantOptions& opt, const FreeEdges* edges) {
   QuadrantComplexResult res;
   QuadrantComplex& qc = res.complex;
-  const LatticeNodes<2> nodes = lattice_nodes(t, &in, HangingFlags::Skipped);
+  const LatticeNodes<2> nodes = lattice_nodes(t, &in, HangingFlags::Skipped, opt.n_threads);
   const FreeEdges computed = edges ? FreeEdges() : free_facets(t, in);
   const FreeEdges& facets = edges ? *edges : computed;
   // The nodes' arrays at their final size (the lattice nodes, then at most a projection a free
@@ -219,7 +220,10 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
   std::vector<std::uint64_t> node_keys;
   reserve_huge(node_keys, nodes.points.size());
-  for (const LP& p : nodes.points) node_keys.push_back(point_key<2>(p));
+  node_keys.resize(nodes.points.size());
+  for_each_range(nodes.points.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) node_keys[n] = point_key<2>(nodes.points[n]);
+  });
   auto find_node = [&](const LP& p) {
     const std::uint64_t key = point_key<2>(p);
     const auto it = std::lower_bound(node_keys.begin(), node_keys.end(), key);
@@ -230,26 +234,42 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // own answer (leaf_corners); a mid-edge node is searched by galloping from the same edge's
   // answer for the previous quadrant (consecutive leaves are near in Morton order): the index
   // a full binary search gives, in a few probes of nearby keys.
-  reserve_huge(qc.interior, static_cast<std::size_t>(std::count_if(in.begin(), in.end(), [](std::uint8_t f) { return f != 0; })));
-  std::array<std::size_t, 4> near{};
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
-    if (!in[i]) continue;
-    const Cell<2>& c = t.leaf(i);
-    InteriorQuadrant q;
-    q.leaf = i;
-    q.level = c.level;
-    for (int k = 0; k < 4; ++k) {
-      q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
-      q.ring.push_back(nodes.leaf_corners[i][FaceCorners<2>::ring[k]]);
-      if (length(c) >= 2) {
-        const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
-        const std::uint64_t key = point_key<2>(midpoint(a, b));
-        near[k] = lower_bound_from(node_keys, key, near[k]);
-        if (near[k] < node_keys.size() && node_keys[near[k]] == key) q.ring.push_back(static_cast<std::int32_t>(near[k]));
+  // Runs of leaves on opt.n_threads threads, each writing its quadrants after the kept leaves
+  // of the runs before it (the serial order).
+  const std::size_t n_leaves = t.n_leaves();
+  const std::size_t n_chunks = 4 * static_cast<std::size_t>(std::clamp(opt.n_threads, 1, 256));
+  const std::size_t run = std::max<std::size_t>(std::size_t(1) << 14, (n_leaves + n_chunks - 1) / n_chunks);
+  const std::size_t n_runs = (n_leaves + run - 1) / run;
+  std::vector<std::size_t> run_start(n_runs + 1, 0);
+  for_each_chunk(n_leaves, run, opt.n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
+    run_start[r + 1] = static_cast<std::size_t>(std::count_if(in.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                              in.begin() + static_cast<std::ptrdiff_t>(end),
+                                                              [](std::uint8_t f) { return f != 0; }));
+  });
+  for (std::size_t r = 0; r < n_runs; ++r) run_start[r + 1] += run_start[r];
+  reserve_huge(qc.interior, run_start[n_runs]);
+  qc.interior.resize(run_start[n_runs]);
+  for_each_chunk(n_leaves, run, opt.n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
+    std::array<std::size_t, 4> near{};
+    std::size_t out = run_start[r];
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!in[i]) continue;
+      const Cell<2>& c = t.leaf(i);
+      InteriorQuadrant& q = qc.interior[out++];
+      q.leaf = i;
+      q.level = c.level;
+      for (int k = 0; k < 4; ++k) {
+        q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
+        q.ring.push_back(nodes.leaf_corners[i][FaceCorners<2>::ring[k]]);
+        if (length(c) >= 2) {
+          const LP a = corner(c, FaceCorners<2>::ring[k]), b = corner(c, FaceCorners<2>::ring[(k + 1) % 4]);
+          const std::uint64_t key = point_key<2>(midpoint(a, b));
+          near[k] = lower_bound_from(node_keys, key, near[k]);
+          if (near[k] < node_keys.size() && node_keys[near[k]] == key) q.ring.push_back(static_cast<std::int32_t>(near[k]));
+        }
       }
     }
-    qc.interior.push_back(std::move(q));
-  }
+  });
 
   // Free edges and their chains.
   res.stats.n_free_edges = facets.size();

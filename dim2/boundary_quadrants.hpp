@@ -71,6 +71,7 @@ struct BoundaryQuadrantOptions {
   bool pull_corners = true;
   double merge_fraction = 0.25;      ///< merge projections closer than this x the cell size
   bool corners_may_fail = false;     ///< at the finest level, leave far corners unpulled
+  int n_threads = 1;                 ///< for the nodes and the interior quadrants' rings
 };
 
 /// `edges`, when given, must be free_facets(t, in) (saves computing it again).

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/huge_pages.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -49,6 +50,46 @@ struct Builder {
     return static_cast<std::int32_t>(out.mesh.points.size() - 1);
   }
   const P2& at(std::int32_t i) const { return out.mesh.points[i]; }
+};
+
+/// What the templates make of one interior quadrant.
+struct QuadrantCount {
+  std::size_t elements = 0, element_nodes = 0, points = 0;
+  QuadrantCount& operator+=(const QuadrantCount& o) {
+    elements += o.elements, element_nodes += o.element_nodes, points += o.points;
+    return *this;
+  }
+};
+QuadrantCount interior_count(const InteriorQuadrant& q, ElementKind kind) {
+  if (q.has_hanging()) return {q.ring.size(), 3 * q.ring.size(), 1};
+  if (kind == ElementKind::Tri) return {2, 6, 0};
+  return {1, 4, 0};
+}
+
+/// A Builder over arrays sized in advance: writes the elements and points of a run of interior
+/// quadrants at the places they have in the serial order, so that runs can be written at once.
+struct Slots {
+  Mesh<2>& m;
+  std::size_t e, k, p;  // the next element, element-node slot and point
+  void element(ElemType t, std::initializer_list<std::int32_t> v, std::uint8_t level) {
+    m.solid.type[e] = t;
+    for (const std::int32_t x : v) m.solid.node[k++] = vid(x);
+    m.solid.offset[e + 1] = static_cast<std::int32_t>(k);
+    m.level[e] = level;
+    m.from_boundary_cell[e] = 0;
+    ++e;
+  }
+  void tri(std::int32_t a, std::int32_t b, std::int32_t c, std::uint8_t level, bool) {
+    element(ElemType::Tri3, {a, b, c}, level);
+  }
+  void quad(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, std::uint8_t level, bool) {
+    element(ElemType::Quad4, {a, b, c, d}, level);
+  }
+  std::int32_t point(const P2& x) {
+    m.points[p] = x;
+    return static_cast<std::int32_t>(p++);
+  }
+  const P2& at(std::int32_t i) const { return m.points[i]; }
 };
 
 /// Whether quad abcd (CCW) splits across a-c: the diagonal with the better smallest angle;
@@ -94,7 +135,8 @@ class SplitMemo {
 };
 
 /// Two triangles of quad abcd (CCW) across the diagonal splits_ac chooses.
-void split_quad(Builder& b, SplitMemo& memo, std::int32_t a, std::int32_t c1, std::int32_t c, std::int32_t d,
+template <class Sink>
+void split_quad(Sink& b, SplitMemo& memo, std::int32_t a, std::int32_t c1, std::int32_t c, std::int32_t d,
                 std::uint8_t level, bool bnd) {
   if (memo.splits_ac(b.at(a), b.at(c1), b.at(c), b.at(d))) {
     b.tri(a, c1, c, level, bnd);
@@ -123,9 +165,11 @@ void best_fan(Builder& b, const std::vector<std::int32_t>& poly, std::uint8_t le
     b.tri(poly[best], poly[(best + k) % n], poly[(best + k + 1) % n], level, bnd);
 }
 
-void interior_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
+/// The templates of qc.interior[begin, end) into b.
+void interior_templates(Slots& b, const QuadrantComplex& qc, ElementKind kind, std::size_t begin, std::size_t end) {
   SplitMemo memo;
-  for (const InteriorQuadrant& q : qc.interior) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const InteriorQuadrant& q = qc.interior[i];
     const auto& r = q.ring;
     const std::int32_t ll = r[q.corner_slot[0]], lr = r[q.corner_slot[1]], ur = r[q.corner_slot[2]],
                        ul = r[q.corner_slot[3]];
@@ -140,6 +184,34 @@ void interior_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind)
     const std::int32_t c = b.point(centre);
     for (std::size_t k = 0; k < r.size(); ++k) b.tri(c, r[k], r[(k + 1) % r.size()], q.level, false);
   }
+}
+
+/// The interior quadrants' templates on n_threads threads, appended to out's elements and points
+/// (which hold the complex's nodes only): each run of quadrants counts what it makes, and writes
+/// it where the serial loop would have put it, so any thread count gives the same mesh.
+void interior_templates(FeBeMesh& out, const QuadrantComplex& qc, ElementKind kind, int n_threads) {
+  const std::size_t n = qc.interior.size();
+  const std::size_t n_runs = std::clamp<std::size_t>(n / 4096, 1, 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256)));
+  const std::size_t run = std::max<std::size_t>(1, (n + n_runs - 1) / n_runs);
+  std::vector<QuadrantCount> start(n_runs + 1);
+  for_each_chunk(n, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) start[c + 1] += interior_count(qc.interior[i], kind);
+  });
+  Mesh<2>& m = out.mesh;
+  start[0] = {m.solid.size(), m.solid.node.size(), m.points.size()};
+  for (std::size_t c = 0; c < n_runs; ++c) start[c + 1] += start[c];
+  const QuadrantCount& total = start[n_runs];
+  m.solid.type.resize(total.elements);
+  m.solid.offset.resize(total.elements + 1);
+  m.solid.node.resize(total.element_nodes);
+  m.level.resize(total.elements);
+  m.from_boundary_cell.resize(total.elements);
+  m.points.resize(total.points);
+  out.where.resize(total.points);
+  for_each_chunk(n, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    Slots slots{m, start[c].elements, start[c].element_nodes, start[c].points};
+    interior_templates(slots, qc, kind, begin, end);
+  });
 }
 
 void boundary_templates(Builder& b, const QuadrantComplex& qc, ElementKind kind) {
@@ -237,14 +309,8 @@ TemplateCounts count_templates(const QuadrantComplex& qc, ElementKind kind) {
   n.points = qc.points.size();
   auto tris = [&](std::size_t k) { n.elements += k, n.element_nodes += 3 * k; };
   for (const InteriorQuadrant& q : qc.interior) {
-    if (q.has_hanging()) {
-      tris(q.ring.size());
-      ++n.points;
-    } else if (kind == ElementKind::Tri) {
-      tris(2);
-    } else {
-      ++n.elements, n.element_nodes += 4;
-    }
+    const QuadrantCount c = interior_count(q, kind);
+    n.elements += c.elements, n.element_nodes += c.element_nodes, n.points += c.points;
   }
   for (const BoundaryQuadrant& q : qc.boundary) {
     if (q.corner >= 0) {
@@ -274,7 +340,7 @@ void reserve(FeBeMesh& out, const TemplateCounts& n) {
   m.interface.node.reserve(2 * n.lines);
 }
 
-FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint) {
+FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint, int n_threads) {
   Builder b;
   const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
   reserve(b.out, count_templates(qc, base));
@@ -282,7 +348,7 @@ FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidp
   b.out.where.resize(qc.points.size());
   for (std::size_t i = 0; i < qc.points.size(); ++i)
     if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where(static_cast<std::int32_t>(i));
-  interior_templates(b, qc, base);
+  interior_templates(b.out, qc, base, n_threads);
   boundary_templates(b, qc, base);
   if (kind == ElementKind::Quad) return split_to_quads(b.out, midpoint);
   return std::move(b.out);

@@ -39,8 +39,9 @@ struct FeBeMesh {
 };
 
 /// Triangles / quads / mixed elements of every quadrant, and the BE edges, sharing nodes.
-/// Quad = the mixed mesh split once (split_to_quads).
-FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint);
+/// Quad = the mixed mesh split once (split_to_quads). The interior quadrants' templates run on
+/// n_threads threads; the mesh is the same for every count.
+FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint, int n_threads = 1);
 
 /// All quadrilaterals: every element split once through its centroid and edge midpoints
 /// (triangle -> 3 quads, quad -> 4), conforming because neighbours share the edge midpoints;

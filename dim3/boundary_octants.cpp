@@ -9,6 +9,7 @@
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
+#include "core/lattice_nodes.hpp"
 #include "core/parallel_ranges.hpp"
 #include "dim3/triangle_predicates.hpp"
 
@@ -682,7 +683,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
                                          const BoundaryOctantOptions& opt) {
   OctantComplexResult res;
   OctantComplex& oc = res.complex;
-  oc.lattice = lattice_nodes(t, &in);
+  oc.lattice = lattice_nodes(t, &in, HangingFlags::Computed, opt.n_threads);
   const std::vector<FreeFacet<3>> facets = free_facets(t, in);
   // A sub-face left by an unkept finer neighbour may have corners that are no kept octant's
   // corner (the middle of a coarse edge): they become nodes too, so that the faces around them

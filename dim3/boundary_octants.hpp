@@ -140,7 +140,7 @@ struct BoundaryOctantOptions {
   /// changes meshes that were valid (anchor 12.73 -> 12.21 deg; elephant then valid only
   /// without feature snapping; spool 14.30 -> 14.54 deg). docs/measurements.md, session f1.
   bool unfold_backward = false;
-  int n_threads = 1;                 ///< threads for the projections (the result is the same for any)
+  int n_threads = 1;                 ///< threads for the nodes and projections (the same result for any)
   bool snap_features = true;
   double corner_radius = 0.75;       ///< pull a corner onto a node within this many face sizes
   double edge_radius = 0.35;         ///< project nodes within this many face sizes onto a feature line

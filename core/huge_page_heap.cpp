@@ -1,0 +1,66 @@
+#include "core/huge_page_heap.hpp"
+
+#include <cstdlib>  // defines __GLIBC__ on glibc
+#include <cstring>
+#include <fstream>
+
+#include <unistd.h>
+
+#if __has_include(<valgrind/valgrind.h>)
+#include <valgrind/valgrind.h>
+#endif
+
+namespace febemesh {
+
+std::optional<std::string> tunables_with_huge_page_heap(const char* current) {
+  const std::string tunable = "glibc.malloc.hugetlb";
+  const std::string now = current ? current : "";
+  // Entries are name=value, separated by ':'.
+  std::size_t begin = 0;
+  while (begin <= now.size()) {
+    std::size_t end = now.find(':', begin);
+    if (end == std::string::npos) end = now.size();
+    const std::string entry = now.substr(begin, end - begin);
+    if (entry.compare(0, tunable.size() + 1, tunable + "=") == 0) return std::nullopt;
+    begin = end + 1;
+  }
+  return now.empty() ? tunable + "=1" : now + ":" + tunable + "=1";
+}
+
+namespace {
+
+bool kernel_has_huge_pages() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  return std::getline(in, modes) && modes.find("[never]") == std::string::npos;
+}
+
+bool under_valgrind() {
+#ifdef RUNNING_ON_VALGRIND
+  return RUNNING_ON_VALGRIND != 0;  // its tools would lose the program at the exec
+#else
+  return false;
+#endif
+}
+
+}  // namespace
+
+void reexec_with_huge_page_heap(char** argv) {
+#if defined(__GLIBC__) && defined(__linux__)
+  const char* opt_out = std::getenv("FEBEMESH_HUGE_PAGES");
+  if (opt_out && std::strcmp(opt_out, "0") == 0) return;
+  const std::optional<std::string> tunables = tunables_with_huge_page_heap(std::getenv("GLIBC_TUNABLES"));
+  if (!tunables || under_valgrind() || !kernel_has_huge_pages()) return;
+  const char* before = std::getenv("GLIBC_TUNABLES");
+  const std::optional<std::string> saved = before ? std::optional<std::string>(before) : std::nullopt;
+  if (setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  // Still here: the exec failed; run on as started (children would inherit the tunable).
+  if (saved) setenv("GLIBC_TUNABLES", saved->c_str(), 1);
+  else unsetenv("GLIBC_TUNABLES");
+#else
+  (void)argv;
+#endif
+}
+
+}  // namespace febemesh
