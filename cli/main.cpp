@@ -9,6 +9,7 @@
 
 #include "cli/command.hpp"
 #include "core/error.hpp"
+#include "core/huge_page_heap.hpp"
 
 #ifndef FEBEMESH_VERSION
 #define FEBEMESH_VERSION "unknown"
@@ -39,6 +40,7 @@ void print_overview(std::ostream& os) {
 }  // namespace febemesh::cli
 
 int main(int argc, char** argv) {
+  febemesh::reexec_with_huge_page_heap(argv);  // first: it may start the program again
   using namespace febemesh::cli;
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) {
