@@ -33,7 +33,9 @@ void print_overview(std::ostream& os) {
         "       febemesh --version\n\n"
         "commands:\n";
   for (const auto& [name, c] : registry()) os << "  " << name << std::string(12 - std::min<std::size_t>(name.size(), 11), ' ') << c.summary << "\n";
-  os << "\nexit status: 0 success, 1 bad input, 2 bad usage\n";
+  os << "\nexit status: 0 success, 1 bad input, 2 bad usage\n"
+        "environment: FEBEMESH_HUGE_PAGES=0 keeps glibc's default malloc (otherwise the program starts\n"
+        "  itself again once with GLIBC_TUNABLES=glibc.malloc.hugetlb=1: 2 MiB pages for its heap)\n";
 }
 
 }  // namespace

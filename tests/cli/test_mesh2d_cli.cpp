@@ -23,8 +23,8 @@ struct Run {
   std::string output;  ///< stdout and stderr
 };
 
-Run run(const std::string& args) {
-  const std::string cmd = std::string("'") + FEBEMESH_CLI + "' " + args + " 2>&1";
+Run run(const std::string& args, const std::string& env = "") {
+  const std::string cmd = env + (env.empty() ? "" : " ") + "'" + FEBEMESH_CLI + "' " + args + " 2>&1";
   Run r;
   FILE* p = popen(cmd.c_str(), "r");
   REQUIRE(p != nullptr);
@@ -105,6 +105,23 @@ TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") 
   const std::string one = read_text(dir / "1" / "mesh.msh"), two = read_text(dir / "2" / "mesh.msh");
   CHECK(one.size() > 10000);
   CHECK(one == two);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart", "[cli][mesh2d]") {
+  // The program starts itself again with glibc.malloc.hugetlb=1 unless FEBEMESH_HUGE_PAGES=0
+  // or GLIBC_TUNABLES sets the tunable already: the same arguments, the same mesh.
+  const auto dir = scratch("hugepages");
+  const std::string args = "mesh2d '" + flange + "' --level 6 --quiet -o '";
+  REQUIRE(run(args + (dir / "default").string() + "'").status == 0);
+  REQUIRE(run(args + (dir / "off").string() + "'", "FEBEMESH_HUGE_PAGES=0").status == 0);
+  REQUIRE(run(args + (dir / "preset").string() + "'", "GLIBC_TUNABLES=glibc.malloc.hugetlb=0").status == 0);
+  const std::string a = read_text(dir / "default" / "mesh.msh");
+  CHECK(a.size() > 10000);
+  CHECK(a == read_text(dir / "off" / "mesh.msh"));
+  CHECK(a == read_text(dir / "preset" / "mesh.msh"));
+  const Run help = run("--help");
+  CHECK(help.output.find("FEBEMESH_HUGE_PAGES") != std::string::npos);
   std::filesystem::remove_all(dir);
 }
 
