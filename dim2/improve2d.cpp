@@ -391,8 +391,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
       // are skipped for the rest of the pass.
-      flipped.clear();
-      std::fill(touched.begin(), touched.end(), 0);
+      flipped.clear();  // (touched is all 0 here: the last pass cleared what it set)
       std::size_t flips = 0;
       for (const EdgeKey key : candidates) {
         const auto lo = static_cast<std::int32_t>(key >> 32), hi = static_cast<std::int32_t>(key & 0xffffffffu);
@@ -446,6 +445,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         flipped.push_back({e0, e1, a, b, c, d});
         ++flips;
       }
+      // Only the flipped triangles were touched: clearing them, not the whole array (a pass
+      // over every element, up to 8 passes a round).
+      for (const auto& f : flipped) touched[static_cast<std::size_t>(f[0])] = touched[static_cast<std::size_t>(f[1])] = 0;
       // (c, a, d) lost b and gained d; (d, b, c) lost a and gained c.
       for (const auto& [e0, e1, a, b, c, d] : flipped) {
         incident.remove(b, e0), incident.remove(a, e1);
