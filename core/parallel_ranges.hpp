@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <exception>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -50,6 +51,20 @@ template <class F> void for_each_chunk(std::size_t n, std::size_t chunk, int n_t
   for_each_range(n_chunks, n_threads, [&](std::size_t first, std::size_t last) {
     for (std::size_t c = first; c < last; ++c) f(c, c * chunk, std::min(n, (c + 1) * chunk));
   });
+}
+
+/// The largest f(i) over [0, n) (-infinity when n is 0; a NaN never wins), on n_threads
+/// threads: a maximum is exact in any order, so the same value for every count.
+template <class F> double range_max(std::size_t n, int n_threads, const F& f) {
+  const std::size_t n_parts = std::size_t(std::clamp(n_threads, 1, 256));
+  std::vector<double> best(n_parts, -std::numeric_limits<double>::infinity());
+  for_each_chunk(n, std::max<std::size_t>(1, (n + n_parts - 1) / n_parts), n_threads,
+                 [&](std::size_t c, std::size_t begin, std::size_t end) {
+                   double m = -std::numeric_limits<double>::infinity();
+                   for (std::size_t i = begin; i < end; ++i) m = std::max(m, static_cast<double>(f(i)));
+                   best[c] = m;
+                 });
+  return *std::max_element(best.begin(), best.end());
 }
 
 }  // namespace febemesh

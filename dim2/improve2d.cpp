@@ -10,6 +10,7 @@
 #include "core/guard_order.hpp"
 #include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/smooth.hpp"
 
 namespace febemesh::dim2 {
@@ -278,7 +279,8 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m) {
   return out;
 }
 
-ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide) {
+ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide,
+                          int n_threads) {
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
   constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
@@ -289,7 +291,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   std::vector<double> cot;
   reserve_huge(cot, m.solid.size());
   cot.resize(m.solid.size());
-  for (std::size_t e = 0; e < m.solid.size(); ++e) cot[e] = element_top_cot(m, e);
+  for_each_range(m.solid.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) cot[e] = element_top_cot(m, e);
+  });
   auto exact = [&](std::size_t e) { return element_min_angle(m, e); };
   // The exact degrees of elements as they stand (not at a trial position), remembered in a
   // direct-mapped table by element id and forgotten where cot changes: a node whose elements
@@ -312,15 +316,15 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   };
   // The smallest degrees over the mesh: only elements within rounding of the largest
   // cotangent (or without a finite one) can hold it.
+  // (On threads: a max and a min, exact in any order.)
   auto mesh_min = [&] {
-    double top = -std::numeric_limits<double>::infinity();
-    for (const double c : cot)
-      if (std::isfinite(c)) top = std::max(top, c);
+    const double top = range_max(cot.size(), n_threads, [&](std::size_t e) {
+      return std::isfinite(cot[e]) ? cot[e] : -std::numeric_limits<double>::infinity();
+    });
     const double band = 1e-12 * (1.0 + top * top);
-    double q = 180.0;
-    for (std::size_t e = 0; e < cot.size(); ++e)
-      if (!std::isfinite(cot[e]) || !(top - cot[e] > band)) q = std::min(q, exact(e));
-    return q;
+    return std::min(180.0, -range_max(cot.size(), n_threads, [&](std::size_t e) {
+      return !std::isfinite(cot[e]) || !(top - cot[e] > band) ? -exact(e) : -180.0;
+    }));
   };
   st.min_angle_before = mesh_min();
 

@@ -48,9 +48,10 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m);
 
 /// `locked[v]`: 0 free, 1 never moves (corners), 2 interface node that may slide along the curve
 /// through `slide` (toward the midpoint of its two interface neighbours); without `slide`,
-/// 2 is the same as 1.
+/// 2 is the same as 1. The per-element set-up and the mesh's smallest angle run on n_threads
+/// threads (the sweeps on one); the same mesh for every count.
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
-                          const SlideFn& slide = {});
+                          const SlideFn& slide = {}, int n_threads = 1);
 /// Slow twin of improve_mesh (recomputes every angle, sorts all half-edges each pass): the same
 /// mesh, for tests.
 ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,

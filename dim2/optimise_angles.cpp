@@ -8,6 +8,7 @@
 
 #include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -141,28 +142,31 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   auto clearly_above = [&](std::size_t e) {
     return badness(e) < (m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? tri_cot : quad_cot);
   };
-  for (std::size_t e = 0; e < n_elems; ++e) q_elem[e] = clearly_above(e) ? std::nan("") : scaled_quality(e);
+  for_each_range(n_elems, opt.n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) q_elem[e] = clearly_above(e) ? std::nan("") : scaled_quality(e);
+  });
   // The mesh's worst q: the measured elements' when one is at or below the target (the others
   // are above it). Else, per kind, it is held by an element within rounding (1e-9 of 1 + b^2)
   // of the kind's largest badness; only those (and the measured ones) are measured.
+  // (On threads: maxima and minima, exact in any order.)
   auto mesh_worst = [&] {
-    double q = 1e300;
-    for (const double qe : q_elem)
-      if (!std::isnan(qe)) q = std::min(q, qe);
+    const auto is_tri = [&](std::size_t e) { return m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3; };
+    double q = std::min(1e300, -range_max(n_elems, opt.n_threads, [&](std::size_t e) {
+                                  return std::isnan(q_elem[e]) ? -inf : -q_elem[e];
+                                }));
     if (q <= opt.target || n_elems == 0) return n_elems ? q : 0.0;
-    double top[2] = {-inf, -inf};  // triangles, quads
-    for (std::size_t e = 0; e < n_elems; ++e) {
-      if (!std::isnan(q_elem[e])) continue;
-      const double b = badness(e);
-      double& t = top[m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? 0 : 1];
-      if (std::isfinite(b)) t = std::max(t, b);
-    }
-    for (std::size_t e = 0; e < n_elems; ++e) {
-      if (!std::isnan(q_elem[e])) continue;
-      const double b = badness(e), t = top[m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3 ? 0 : 1];
-      if (!std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t)) q = std::min(q, scaled_quality(e));
-    }
-    return q;
+    double top[2];  // triangles, quads
+    for (const int kind : {0, 1})
+      top[kind] = range_max(n_elems, opt.n_threads, [&](std::size_t e) {
+        if (!std::isnan(q_elem[e]) || is_tri(e) != (kind == 0)) return -inf;
+        const double b = badness(e);
+        return std::isfinite(b) ? b : -inf;
+      });
+    return std::min(q, -range_max(n_elems, opt.n_threads, [&](std::size_t e) {
+                      if (!std::isnan(q_elem[e])) return -inf;
+                      const double b = badness(e), t = top[is_tri(e) ? 0 : 1];
+                      return !std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t) ? -scaled_quality(e) : -inf;
+                    }));
   };
   st.worst_before = mesh_worst();
   // The worst cached q around v; at least the target when all of v's elements are clearly

@@ -34,6 +34,9 @@ struct AngleOptimiseOptions {
   /// its two BE chords stay as close to the curve as they were (the larger of the two chord
   /// midpoints' distances does not grow), so raising angles never costs boundary fidelity.
   std::function<double(const Point<2>&)> curve_distance;
+  /// Threads for the per-element set-up and the mesh's worst q (the sweeps run on one); the
+  /// same mesh for every count.
+  int n_threads = 1;
 };
 
 struct AngleOptimiseStats {

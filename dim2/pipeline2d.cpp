@@ -166,7 +166,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       if (opt.improve_rounds > 0) {
         say("quality: edge flips and angle-guarded smoothing");
         lock_interface();
-        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide);
+        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide, opt.n_threads);
         settle_interface();
         r.n_flips = is.flips;
         clock.lap("quality pass");
@@ -189,6 +189,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
         ao.target = opt.elements == ElementKind::Tri ? 1.5 : 1.25;
         if (opt.elements == ElementKind::Mixed) ao.triangle_target = 1.5;
         ao.curve_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
+        ao.n_threads = opt.n_threads;
         r.n_angle_moves = optimise_angles(fe.mesh, locked, ao, slide).moves;
         settle_interface();
         clock.lap("angle optimisation");
