@@ -4,6 +4,7 @@
 #include <cstring>
 #include <fstream>
 
+#include <sys/auxv.h>
 #include <unistd.h>
 
 #if __has_include(<valgrind/valgrind.h>)
@@ -35,6 +36,17 @@ bool kernel_has_huge_pages() {
   return std::getline(in, modes) && modes.find("[never]") == std::string::npos;
 }
 
+/// The program was started through the dynamic loader (ld.so PROGRAM ...): the kernel then ran
+/// ld.so itself, with no interpreter (AT_BASE 0), and /proc/self/exe is ld.so, which would take
+/// the first argument for the program to run.
+bool started_by_loader() {
+#ifdef AT_BASE
+  return getauxval(AT_BASE) == 0;
+#else
+  return true;
+#endif
+}
+
 bool under_valgrind() {
 #ifdef RUNNING_ON_VALGRIND
   return RUNNING_ON_VALGRIND != 0;  // its tools would lose the program at the exec
@@ -50,7 +62,7 @@ void reexec_with_huge_page_heap(char** argv) {
   const char* opt_out = std::getenv("FEBEMESH_HUGE_PAGES");
   if (opt_out && std::strcmp(opt_out, "0") == 0) return;
   const std::optional<std::string> tunables = tunables_with_huge_page_heap(std::getenv("GLIBC_TUNABLES"));
-  if (!tunables || under_valgrind() || !kernel_has_huge_pages()) return;
+  if (!tunables || under_valgrind() || started_by_loader() || !kernel_has_huge_pages()) return;
   const char* before = std::getenv("GLIBC_TUNABLES");
   const std::optional<std::string> saved = before ? std::optional<std::string>(before) : std::nullopt;
   if (setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;

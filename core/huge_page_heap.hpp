@@ -15,8 +15,9 @@ std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 /// Runs the program again, in the same process (/proc/self/exe, the same arguments), with
 /// tunables_with_huge_page_heap in its environment, and returns only when it does not: the
 /// tunable is set already (this is the second start), FEBEMESH_HUGE_PAGES=0, the kernel has
-/// transparent huge pages off, the C library is not glibc, the process runs under valgrind, or
-/// the exec fails. Call it first thing in main.
+/// transparent huge pages off, the C library is not glibc, the process runs under valgrind or
+/// was started through the dynamic loader (ld.so PROGRAM), or the exec fails. Call it first
+/// thing in main.
 ///
 /// Why: the 2D pipeline's arrays under 32 MiB live in malloc's heap (dim2/heap_policy), which
 /// glibc grows by 4 KiB pages; on this VM a 4 KiB fault costs ~11 us (3 s a GiB touched against

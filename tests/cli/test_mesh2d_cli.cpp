@@ -122,6 +122,21 @@ TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart
   CHECK(a == read_text(dir / "preset" / "mesh.msh"));
   const Run help = run("--help");
   CHECK(help.output.find("FEBEMESH_HUGE_PAGES") != std::string::npos);
+  // Started through the dynamic loader, /proc/self/exe is the loader: no restart then (it would
+  // run the loader with the arguments).
+  for (const char* loader : {"/lib64/ld-linux-x86-64.so.2", "/lib/ld-linux-aarch64.so.1"}) {
+    if (!std::filesystem::exists(loader)) continue;
+    const std::string cmd = std::string(loader) + " '" + FEBEMESH_CLI + "' " + args + (dir / "loader").string() + "' 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    REQUIRE(p != nullptr);
+    char buf[4096];
+    std::string out;
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+    const int st = pclose(p);
+    INFO(cmd << "\n" << out);
+    CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));
+    CHECK(a == read_text(dir / "loader" / "mesh.msh"));
+  }
   std::filesystem::remove_all(dir);
 }
 
