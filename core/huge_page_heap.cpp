@@ -61,9 +61,9 @@ void reexec_with_huge_page_heap(char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
   const char* opt_out = std::getenv("FEBEMESH_HUGE_PAGES");
   if (opt_out && std::strcmp(opt_out, "0") == 0) return;
-  const std::optional<std::string> tunables = tunables_with_huge_page_heap(std::getenv("GLIBC_TUNABLES"));
-  if (!tunables || under_valgrind() || started_by_loader() || !kernel_has_huge_pages()) return;
   const char* before = std::getenv("GLIBC_TUNABLES");
+  const std::optional<std::string> tunables = tunables_with_huge_page_heap(before);
+  if (!tunables || under_valgrind() || started_by_loader() || !kernel_has_huge_pages()) return;
   const std::optional<std::string> saved = before ? std::optional<std::string>(before) : std::nullopt;
   if (setenv("GLIBC_TUNABLES", tunables->c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);

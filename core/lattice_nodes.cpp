@@ -134,17 +134,16 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, Hangi
   // Every kept leaf's corner keys, in leaf order: each run of leaves writes at its count of
   // kept leaves before it.
   const std::size_t n_leaves = t.n_leaves();
-  const std::size_t n_chunks = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
-  const std::size_t run = std::max<std::size_t>(std::size_t(1) << 14, (n_leaves + n_chunks - 1) / n_chunks);
-  const std::size_t n_runs = (n_leaves + run - 1) / run;
-  std::vector<std::size_t> run_start(n_runs + 1, 0);
-  for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) run_start[c + 1] += kept(i) ? 1 : 0;
-  });
-  for (std::size_t c = 0; c < n_runs; ++c) run_start[c + 1] += run_start[c];
+  const std::size_t run = chunk_size(n_leaves, n_threads, std::size_t(1) << 14);
+  const std::vector<std::size_t> run_start =
+      chunk_starts(n_leaves, run, n_threads, std::size_t{0}, [&](std::size_t begin, std::size_t end) {
+        std::size_t k = 0;
+        for (std::size_t i = begin; i < end; ++i) k += kept(i) ? 1 : 0;
+        return k;
+      });
   std::vector<std::uint64_t> keys;
   reserve_huge(keys, t.n_leaves() * n_corners);
-  keys.resize(run_start[n_runs] * n_corners);
+  keys.resize(run_start.back() * n_corners);
   for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     std::uint64_t* out = keys.data() + run_start[c] * n_corners;
     for (std::size_t i = begin; i < end; ++i) {

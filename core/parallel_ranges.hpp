@@ -53,6 +53,26 @@ template <class F> void for_each_chunk(std::size_t n, std::size_t chunk, int n_t
   });
 }
 
+/// A chunk size for for_each_chunk over [0, n): about four chunks a thread, at least min_chunk.
+inline std::size_t chunk_size(std::size_t n, int n_threads, std::size_t min_chunk) {
+  const std::size_t n_chunks = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
+  return std::max<std::size_t>(std::max<std::size_t>(min_chunk, 1), (n + n_chunks - 1) / n_chunks);
+}
+
+/// Where each chunk of for_each_chunk(n, chunk, ...) starts writing when chunk c writes
+/// count(begin, end) items (a T with +=) after those of the chunks before it, from `first`: the
+/// serial loop's layout, so that the chunks can then be written at once. n_chunks + 1 entries,
+/// the last the end; the counts run on n_threads threads, the same layout for every count.
+template <class T, class Count>
+std::vector<T> chunk_starts(std::size_t n, std::size_t chunk, int n_threads, const T& first, const Count& count) {
+  const std::size_t n_chunks = (n + chunk - 1) / chunk;
+  std::vector<T> start(n_chunks + 1, T{});
+  for_each_chunk(n, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) { start[c + 1] = count(begin, end); });
+  start[0] = first;
+  for (std::size_t c = 0; c < n_chunks; ++c) start[c + 1] += start[c];
+  return start;
+}
+
 /// The largest f(i) over [0, n) (-infinity when n is 0; a NaN never wins), on n_threads
 /// threads: a maximum is exact in any order, so the same value for every count.
 template <class F> double range_max(std::size_t n, int n_threads, const F& f) {
@@ -65,6 +85,11 @@ template <class F> double range_max(std::size_t n, int n_threads, const F& f) {
                    best[c] = m;
                  });
   return *std::max_element(best.begin(), best.end());
+}
+
+/// The smallest f(i) over [0, n) (+infinity when n is 0; a NaN never wins), as range_max.
+template <class F> double range_min(std::size_t n, int n_threads, const F& f) {
+  return -range_max(n, n_threads, [&](std::size_t i) { return -static_cast<double>(f(i)); });
 }
 
 }  // namespace febemesh

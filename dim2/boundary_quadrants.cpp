@@ -237,18 +237,15 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // Runs of leaves on opt.n_threads threads, each writing its quadrants after the kept leaves
   // of the runs before it (the serial order).
   const std::size_t n_leaves = t.n_leaves();
-  const std::size_t n_chunks = 4 * static_cast<std::size_t>(std::clamp(opt.n_threads, 1, 256));
-  const std::size_t run = std::max<std::size_t>(std::size_t(1) << 14, (n_leaves + n_chunks - 1) / n_chunks);
-  const std::size_t n_runs = (n_leaves + run - 1) / run;
-  std::vector<std::size_t> run_start(n_runs + 1, 0);
-  for_each_chunk(n_leaves, run, opt.n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
-    run_start[r + 1] = static_cast<std::size_t>(std::count_if(in.begin() + static_cast<std::ptrdiff_t>(begin),
-                                                              in.begin() + static_cast<std::ptrdiff_t>(end),
-                                                              [](std::uint8_t f) { return f != 0; }));
-  });
-  for (std::size_t r = 0; r < n_runs; ++r) run_start[r + 1] += run_start[r];
-  reserve_huge(qc.interior, run_start[n_runs]);
-  qc.interior.resize(run_start[n_runs]);
+  const std::size_t run = chunk_size(n_leaves, opt.n_threads, std::size_t(1) << 14);
+  const std::vector<std::size_t> run_start =
+      chunk_starts(n_leaves, run, opt.n_threads, std::size_t{0}, [&](std::size_t begin, std::size_t end) {
+        return static_cast<std::size_t>(std::count_if(in.begin() + static_cast<std::ptrdiff_t>(begin),
+                                                      in.begin() + static_cast<std::ptrdiff_t>(end),
+                                                      [](std::uint8_t f) { return f != 0; }));
+      });
+  reserve_huge(qc.interior, run_start.back());
+  qc.interior.resize(run_start.back());
   for_each_chunk(n_leaves, run, opt.n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
     std::array<std::size_t, 4> near{};
     std::size_t out = run_start[r];

@@ -322,8 +322,8 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       return std::isfinite(cot[e]) ? cot[e] : -std::numeric_limits<double>::infinity();
     });
     const double band = 1e-12 * (1.0 + top * top);
-    return std::min(180.0, -range_max(cot.size(), n_threads, [&](std::size_t e) {
-      return !std::isfinite(cot[e]) || !(top - cot[e] > band) ? -exact(e) : -180.0;
+    return std::min(180.0, range_min(cot.size(), n_threads, [&](std::size_t e) {
+      return !std::isfinite(cot[e]) || !(top - cot[e] > band) ? exact(e) : 180.0;
     }));
   };
   st.min_angle_before = mesh_min();

@@ -151,8 +151,8 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // (On threads: maxima and minima, exact in any order.)
   auto mesh_worst = [&] {
     const auto is_tri = [&](std::size_t e) { return m.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)}) == 3; };
-    double q = std::min(1e300, -range_max(n_elems, opt.n_threads, [&](std::size_t e) {
-                                  return std::isnan(q_elem[e]) ? -inf : -q_elem[e];
+    double q = std::min(1e300, range_min(n_elems, opt.n_threads, [&](std::size_t e) {
+                                  return std::isnan(q_elem[e]) ? inf : q_elem[e];
                                 }));
     if (q <= opt.target || n_elems == 0) return n_elems ? q : 0.0;
     double top[2];  // triangles, quads
@@ -162,10 +162,10 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
         const double b = badness(e);
         return std::isfinite(b) ? b : -inf;
       });
-    return std::min(q, -range_max(n_elems, opt.n_threads, [&](std::size_t e) {
-                      if (!std::isnan(q_elem[e])) return -inf;
+    return std::min(q, range_min(n_elems, opt.n_threads, [&](std::size_t e) {
+                      if (!std::isnan(q_elem[e])) return inf;
                       const double b = badness(e), t = top[is_tri(e) ? 0 : 1];
-                      return !std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t) ? -scaled_quality(e) : -inf;
+                      return !std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t) ? scaled_quality(e) : inf;
                     }));
   };
   st.worst_before = mesh_worst();

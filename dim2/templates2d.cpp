@@ -191,16 +191,16 @@ void interior_templates(Slots& b, const QuadrantComplex& qc, ElementKind kind, s
 /// it where the serial loop would have put it, so any thread count gives the same mesh.
 void interior_templates(FeBeMesh& out, const QuadrantComplex& qc, ElementKind kind, int n_threads) {
   const std::size_t n = qc.interior.size();
-  const std::size_t n_runs = std::clamp<std::size_t>(n / 4096, 1, 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256)));
-  const std::size_t run = std::max<std::size_t>(1, (n + n_runs - 1) / n_runs);
-  std::vector<QuadrantCount> start(n_runs + 1);
-  for_each_chunk(n, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) start[c + 1] += interior_count(qc.interior[i], kind);
-  });
+  const std::size_t run = chunk_size(n, n_threads, 4096);
   Mesh<2>& m = out.mesh;
-  start[0] = {m.solid.size(), m.solid.node.size(), m.points.size()};
-  for (std::size_t c = 0; c < n_runs; ++c) start[c + 1] += start[c];
-  const QuadrantCount& total = start[n_runs];
+  const std::vector<QuadrantCount> start =
+      chunk_starts(n, run, n_threads, QuadrantCount{m.solid.size(), m.solid.node.size(), m.points.size()},
+                   [&](std::size_t begin, std::size_t end) {
+                     QuadrantCount c;
+                     for (std::size_t i = begin; i < end; ++i) c += interior_count(qc.interior[i], kind);
+                     return c;
+                   });
+  const QuadrantCount& total = start.back();
   m.solid.type.resize(total.elements);
   m.solid.offset.resize(total.elements + 1);
   m.solid.node.resize(total.element_nodes);

@@ -22,3 +22,29 @@ TEST_CASE("range_max is the serial maximum on any thread count", "[parallel_rang
   }
   CHECK(range_max(0, 2, [](std::size_t) { return 1.0; }) == -std::numeric_limits<double>::infinity());
 }
+
+TEST_CASE("range_min is the serial minimum; chunk_starts is the serial layout", "[parallel_ranges][threads]") {
+  std::vector<double> v(50001);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::cos(0.11 * static_cast<double>(i)) * static_cast<double>(i % 313);
+  double serial = std::numeric_limits<double>::infinity();
+  for (const double x : v) serial = std::min(serial, x);
+  // Items per position: i % 5 (0 for some), laid out in order from 7.
+  std::vector<std::size_t> serial_start{7};
+  for (std::size_t i = 0; i < v.size(); ++i) serial_start.push_back(serial_start.back() + i % 5);
+  for (const int threads : {1, 2, 3, 8}) {
+    INFO(threads << " threads");
+    CHECK(range_min(v.size(), threads, [&](std::size_t i) { return v[i]; }) == serial);
+    const std::size_t chunk = chunk_size(v.size(), threads, 1000);
+    CHECK(chunk >= 1000);
+    const std::vector<std::size_t> start = chunk_starts(v.size(), chunk, threads, std::size_t{7}, [](std::size_t b, std::size_t e) {
+      std::size_t k = 0;
+      for (std::size_t i = b; i < e; ++i) k += i % 5;
+      return k;
+    });
+    REQUIRE(start.size() == (v.size() + chunk - 1) / chunk + 1);
+    for (std::size_t c = 0; c + 1 < start.size(); ++c) CHECK(start[c] == serial_start[c * chunk]);
+    CHECK(start.back() == serial_start.back());
+  }
+  CHECK(range_min(0, 2, [](std::size_t) { return 1.0; }) == std::numeric_limits<double>::infinity());
+  CHECK(chunk_starts(0, 16, 2, std::size_t{3}, [](std::size_t, std::size_t) { return std::size_t{1}; }) == std::vector<std::size_t>{3});
+}
