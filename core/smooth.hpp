@@ -1,7 +1,7 @@
 #pragma once
 // Guarded Laplacian smoothing (paper, step 4; DESIGN.md pipeline step 4), generic over Dim.
-// Gauss-Seidel sweeps in node order: an interior node moves to the centroid of its neighbours
-// along element edges. A move is accepted only if no incident element inverts and the minimum
+// Gauss-Seidel sweeps in node order (or slab order, `parts`): an interior node moves to the
+// centroid of its neighbours along element edges. A move is accepted only if no incident element inverts and the minimum
 // scaled Jacobian of the incident elements does not drop. Boundary nodes (nodes of boundary
 // facets of the solid) stay put unless `project` is given: then they move to the centroid of
 // their neighbours along the boundary and are projected back, under the same guard.
@@ -41,9 +41,10 @@ template <int Dim> struct SmoothOptions {
   /// Threads for the neighbour lists, the element states and the sweeps (project must then be
   /// safe to call concurrently); the result is the same, bit for bit, for every count.
   int n_threads = 1;
-  /// Threads for the in-order sweeps alone, when > 0 (else n_threads): where a visit costs
-  /// less than scheduling it on the sweep's DAG (the 2D pipeline), the sweeps run serially.
-  int sweep_threads = 0;
+  /// When > 0, the sweeps visit the nodes in a partitioned order instead of node order
+  /// (core/partitioned_sweep.hpp: that many slabs, each slab's inner nodes, then the nodes on
+  /// the cuts), the same mesh for every thread count.
+  int parts = 0;
 };
 
 struct SmoothStats {

@@ -4,13 +4,17 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <set>
 #include <span>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/guard_order.hpp"
 #include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/partitioned_sweep.hpp"
 #include "core/smooth.hpp"
 
 namespace febemesh::dim2 {
@@ -232,6 +236,14 @@ class LiveIncidence {
   std::vector<std::int32_t> first_, elem_;
 };
 
+/// The exact degrees of some elements, by element id (direct-mapped), for improve_mesh.
+struct Memo {
+  static constexpr std::size_t n = 4096;
+  std::vector<std::int32_t> elem = std::vector<std::int32_t>(n, -1);
+  std::vector<double> deg = std::vector<double>(n);
+  void clear() { std::fill(elem.begin(), elem.end(), -1); }
+};
+
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
 int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -299,19 +311,19 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // direct-mapped table by element id and forgotten where cot changes: a node whose elements
   // tie in cotangent asks for all their degrees, and its neighbours, visited next, ask for
   // most of the same (flange level 9: most of the atan2 calls of this stage).
-  constexpr std::size_t n_memo = 4096;
-  std::vector<std::int32_t> memo_elem(n_memo, -1);
-  std::vector<double> memo_deg(n_memo);
-  auto exact_now = [&](std::size_t e) {
-    const std::size_t slot = e & (n_memo - 1);
-    if (memo_elem[slot] != static_cast<std::int32_t>(e)) {
-      memo_deg[slot] = exact(e);
-      memo_elem[slot] = static_cast<std::int32_t>(e);
+  // One per thread of the node sweep (core/partitioned_sweep.hpp: elements of two threads' nodes
+  // are disjoint while a part runs; the tables are cleared where that ends). The flips use the
+  // caller's, worker 0.
+  auto exact_in = [&](Memo& memo, std::size_t e) {
+    const std::size_t slot = e & (Memo::n - 1);
+    if (memo.elem[slot] != static_cast<std::int32_t>(e)) {
+      memo.deg[slot] = exact(e);
+      memo.elem[slot] = static_cast<std::int32_t>(e);
     }
-    return memo_deg[slot];
+    return memo.deg[slot];
   };
-  auto forget = [&](std::int32_t e) {
-    std::int32_t& held = memo_elem[static_cast<std::size_t>(e) & (n_memo - 1)];
+  auto forget_in = [&](Memo& memo, std::int32_t e) {
+    std::int32_t& held = memo.elem[static_cast<std::size_t>(e) & (Memo::n - 1)];
     if (held == e) held = -1;
   };
   // The smallest degrees over the mesh: only elements within rounding of the largest
@@ -348,9 +360,9 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // below -4e-7 (hi2 = good_cot^2), far past the slack, so exceeds() says false too. Most
   // triangles are (the candidate scan asks of every triangle in every flip pass).
   const double clearly_good_cot = good_cot - 1e-6;
-  auto is_good = [&](std::size_t e) {  // exact(e) >= good
+  auto is_good = [&](Memo& memo, std::size_t e) {  // exact(e) >= good
     if (cot[e] >= 0.0 && cot[e] < clearly_good_cot) return true;
-    return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact_now(e); }, 0.0);
+    return !exceeds(good_cot, [&] { return good; }, cot[e], [&] { return exact_in(memo, e); }, 0.0);
   };
   std::vector<EdgeKey> candidates;
   // The triangles that may be below `good`: a superset, kept instead of asking is_good of every
@@ -359,23 +371,45 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // accepted move); a pass keeps only those still below `good`. The candidates are sorted, so
   // they are the same edges in the same order as from the scan of all triangles.
   std::vector<std::int32_t> unsure;
-  auto maybe_bad = [&](std::int32_t e) {
+  auto maybe_bad_to = [&](std::vector<std::int32_t>& list, std::int32_t e) {
     const double c = cot[static_cast<std::size_t>(e)];
-    if (m.solid.type[static_cast<std::size_t>(e)] == ElemType::Tri3 && !(c >= 0.0 && c < clearly_good_cot)) unsure.push_back(e);
+    if (m.solid.type[static_cast<std::size_t>(e)] == ElemType::Tri3 && !(c >= 0.0 && c < clearly_good_cot)) list.push_back(e);
   };
-  for (std::size_t e = 0; e < m.solid.size(); ++e) maybe_bad(static_cast<std::int32_t>(e));
+  for (std::size_t e = 0; e < m.solid.size(); ++e) maybe_bad_to(unsure, static_cast<std::int32_t>(e));
   LiveIncidence incident(m);
   // A pass looks triangles up at the start's connectivity: its flips (e0, e1, a, b, c, d) update
   // the incidence after it (a flipped triangle is `touched` and skipped until then anyway).
   std::vector<std::array<std::int32_t, 6>> flipped;
-  std::vector<std::uint8_t> listed(n_nodes, 0);  // w is among the neighbours being gathered
   std::vector<std::uint8_t> touched(m.solid.size(), 0);
   // settled[v]: v's last guarded move was rejected and no node of its elements has moved nor
   // has any of its elements flipped since; its target, its elements' angles and the trial
   // angles would be the same numbers, so it would be rejected again and is skipped.
   std::vector<std::uint8_t> settled(n_nodes, 0);
-  std::vector<std::int32_t> nb;
-  std::vector<double> trial_cot, trial_deg;
+  // The node sweep's working space, one per thread.
+  struct alignas(64) Worker {
+    Memo memo;
+    std::vector<std::uint8_t> listed;  ///< w is among the neighbours being gathered
+    std::vector<std::int32_t> nb, unsure;
+    std::vector<double> trial_cot, trial_deg;
+    std::size_t moves = 0;
+  };
+  // The nodes in slabs, cut once (the node sweep's order, core/partitioned_sweep.hpp).
+  const std::vector<std::uint8_t> part = slab_parts<2>(m.points, default_sweep_parts, n_threads);
+  // The separators of the first mesh; a flip whose four nodes lie in two parts or more makes
+  // them all separators (so every element across parts has only separators: the parts' inner
+  // nodes still share no element), instead of a pass over all elements after each round's
+  // flips (2.4% of a flange run at 5.4 M triangles).
+  std::vector<std::uint8_t> sep = separators(part, m.solid, n_threads);
+  const auto flip_crosses = [&](std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
+    return part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(b)] ||
+           part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(c)] ||
+           part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(d)];
+  };
+  std::vector<Worker> workers(static_cast<std::size_t>(std::max(1, n_threads)));
+  for (Worker& w : workers) w.listed.assign(n_nodes, 0);
+  Memo& memo0 = workers[0].memo;
+  std::optional<PartitionedSweep> sweep;
+  bool new_separators = false;
   for (int round = 0; round < rounds; ++round) {
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
@@ -384,7 +418,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       unsure.erase(std::unique(unsure.begin(), unsure.end()), unsure.end());
       std::size_t n_unsure = 0;
       for (const std::int32_t e : unsure) {
-        if (is_good(static_cast<std::size_t>(e))) continue;
+        if (is_good(memo0, static_cast<std::size_t>(e))) continue;
         unsure[n_unsure++] = e;
         const VertexId* v = m.solid.nodes(ElemId{e});
         for (int k = 0; k < 3; ++k) candidates.push_back(key_of(v[k].v, v[(k + 1) % 3].v));
@@ -409,7 +443,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         }
         if (n_pair != 2) continue;  // a boundary edge, or (never in a valid mesh) an edge of 3+ triangles
         const std::int32_t e0 = std::min(pair[0], pair[1]), e1 = std::max(pair[0], pair[1]);
-        if (is_good(static_cast<std::size_t>(e0)) && is_good(static_cast<std::size_t>(e1))) continue;
+        if (is_good(memo0, static_cast<std::size_t>(e0)) && is_good(memo0, static_cast<std::size_t>(e1))) continue;
         if (std::binary_search(interface_edge.begin(), interface_edge.end(), key)) continue;
         if (touched[e0] || touched[e1]) continue;
         VertexId* v0 = m.solid.node.data() + m.solid.offset[e0];
@@ -444,9 +478,13 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         settled[a] = settled[b] = settled[c] = settled[d] = 0;
         cot[e0] = tc[2];
         cot[e1] = tc[3];
-        maybe_bad(e0), maybe_bad(e1);
-        forget(e0), forget(e1);
+        maybe_bad_to(unsure, e0), maybe_bad_to(unsure, e1);
+        forget_in(memo0, e0), forget_in(memo0, e1);
         flipped.push_back({e0, e1, a, b, c, d});
+        if (flip_crosses(a, b, c, d) && !(sep[a] && sep[b] && sep[c] && sep[d])) {
+          sep[a] = sep[b] = sep[c] = sep[d] = 1;
+          new_separators = true;
+        }
         ++flips;
       }
       // Only the flipped triangles were touched: clearing them, not the whole array (a pass
@@ -465,25 +503,36 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     }
 
     // ---- guarded smoothing on the smallest angle ----
-    for (std::size_t v = 0; v < n_nodes; ++v) {
+    // In slabs on threads (core/partitioned_sweep.hpp): a visit reads and writes only v, its
+    // elements' cotangents and (marks) the settled flags of their nodes.
+    // (The order changes only where a flip made separators.)
+    if (new_separators || !sweep) {
+      const auto is_swept = [&](std::int32_t v) { return !locked[v] || (locked[v] == 2 && slide); };
+      sweep.emplace(part, default_sweep_parts, sep, is_swept, n_threads);
+      new_separators = false;
+    }
+    sweep->run([&](std::int32_t vi, int thread) {
+      Worker& my = workers[static_cast<std::size_t>(thread)];
+      const auto v = static_cast<std::size_t>(vi);
+      std::vector<std::int32_t>& nb = my.nb;
       const bool sliding = locked[v] == 2 && slide;
-      if (settled[v] || (locked[v] && !sliding)) continue;
+      if (settled[v]) return;
       const auto elems = incident.of(static_cast<std::int32_t>(v));
-      if (elems.empty()) continue;
+      if (elems.empty()) return;
       if (sliding) {
         nb.assign(curve_neighbours.of(v).begin(), curve_neighbours.of(v).end());
       } else {
         // The distinct edge neighbours, ascending (the centroid below sums them in that order).
         nb.clear();
-        append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v), elems, nb, listed);
+        append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v), elems, nb, my.listed);
       }
-      if (nb.empty()) continue;
+      if (nb.empty()) return;
       P2 target = P2::Zero();
       for (std::int32_t w : nb) target += m.points[w];
       target /= static_cast<double>(nb.size());
       if (within_rounding<2>(m.points, static_cast<std::int32_t>(v), nb, target, rounding_share)) {
         settled[v] = 1;  // the same numbers until a node of its elements moves
-        continue;
+        return;
       }
       // old_q, the smallest angle of v's elements, by cotangent: elems[worst] holds it. Its
       // exact degrees are computed only if a comparison needs them, as the smallest over all
@@ -509,15 +558,17 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
           m.points[v] = saved;
           if (tie || !all_finite) {
             old_deg = 180.0;
-            for (const std::int32_t e : elems) old_deg = std::min(old_deg, exact_now(static_cast<std::size_t>(e)));
+            for (const std::int32_t e : elems) old_deg = std::min(old_deg, exact_in(my.memo, static_cast<std::size_t>(e)));
           } else {
-            old_deg = exact_now(static_cast<std::size_t>(elems[worst]));
+            old_deg = exact_in(my.memo, static_cast<std::size_t>(elems[worst]));
           }
           m.points[v] = tried;
         }
         return old_deg;
       };
       bool moved = false;
+      std::vector<double>& trial_cot = my.trial_cot;
+      std::vector<double>& trial_deg = my.trial_deg;
       trial_cot.resize(elems.size());
       trial_deg.resize(elems.size());
       for (double step : {1.0, 0.5, 0.25}) {
@@ -545,19 +596,27 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         }
       }
       if (moved) {
-        ++st.moves;
+        ++my.moves;
         for (std::size_t k = 0; k < elems.size(); ++k) {
           cot[elems[k]] = trial_cot[k];  // the accepted trial's
-          maybe_bad(elems[k]);
-          forget(elems[k]);
+          maybe_bad_to(my.unsure, elems[k]);
+          forget_in(my.memo, elems[k]);
           const ElemId id{elems[k]};
           const VertexId* ev = m.solid.nodes(id);
-          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) mark(settled[ev[j].v], 0);
         }
       } else {
         m.points[v] = saved;
         settled[v] = 1;
       }
+    },
+    [&] { for (Worker& w : workers) w.memo.clear(); },
+    [&](std::int32_t v) { return settled[v] != 0; });
+    for (Worker& w : workers) {
+      w.memo.clear();
+      st.moves += std::exchange(w.moves, 0);
+      unsure.insert(unsure.end(), w.unsure.begin(), w.unsure.end());
+      w.unsure.clear();
     }
   }
   st.min_angle_after = mesh_min();
@@ -597,6 +656,9 @@ ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locke
     int local;
   };
   std::vector<HalfEdge> half;
+  // The node sweep's order: improve_mesh's (slabs cut once, separators after each round's flips).
+  const std::vector<std::uint8_t> part = slab_parts<2>(m.points, default_sweep_parts, 1);
+  std::vector<std::uint8_t> sep = separators(part, m.solid, 1);  // and the nodes of flips across parts
   for (int round = 0; round < rounds; ++round) {
     for (std::size_t e = 0; e < m.solid.size(); ++e) angle[e] = min_corner_angle_deg(m, e);
     // ---- flips: triangles only; repeat passes until none improves ----
@@ -635,6 +697,8 @@ ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locke
         // New triangles (c, a, d) and (d, b, c): both positive since after > before >= -1.
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
+        const std::set<std::uint8_t> parts{part[a], part[b], part[c], part[d]};
+        if (parts.size() > 1) sep[a] = sep[b] = sep[c] = sep[d] = 1;
         touched[e0] = touched[e1] = 1;
         angle[e0] = tri_min_angle(pc, pa, pd);
         angle[e1] = tri_min_angle(pd, pb, pc);
@@ -661,7 +725,9 @@ ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locke
         neighbours[v[k].v].push_back(v[(k + n - 1) % n].v);
       }
     }
-    for (std::size_t v = 0; v < n_nodes; ++v) {
+    const PartitionedSweep sweep(part, default_sweep_parts, sep, [](std::int32_t) { return true; }, 1);
+    for (const std::int32_t vi : sweep.order()) {
+      const auto v = static_cast<std::size_t>(vi);
       const bool sliding = locked[v] == 2 && slide;
       if ((locked[v] && !sliding) || incident[v].empty()) continue;
       auto& nb = sliding ? curve_neighbours[v] : neighbours[v];

@@ -7,7 +7,8 @@
 //     then half, then a quarter) only if the smallest angle of its elements rises.
 // The mesh stays conforming and valid: every accepted change keeps all elements positive.
 // Interface elements keep their nodes; interface nodes only slide along the curve (optional).
-// Deterministic (fixed orders).
+// Deterministic (fixed orders: flips by edge key, nodes in the slab order of
+// core/partitioned_sweep.hpp).
 
 #include <cstdint>
 #include <functional>
@@ -48,8 +49,9 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m);
 
 /// `locked[v]`: 0 free, 1 never moves (corners), 2 interface node that may slide along the curve
 /// through `slide` (toward the midpoint of its two interface neighbours); without `slide`,
-/// 2 is the same as 1. The per-element set-up and the mesh's smallest angle run on n_threads
-/// threads (the sweeps on one); the same mesh for every count.
+/// 2 is the same as 1. The per-element set-up, the mesh's smallest angle and the smoothing sweeps
+/// (in slabs, core/partitioned_sweep.hpp; `slide` must then be safe to call concurrently for
+/// different nodes) run on n_threads threads, the flips on one; the same mesh for every count.
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
                           const SlideFn& slide = {}, int n_threads = 1);
 /// Slow twin of improve_mesh (recomputes every angle, sorts all half-edges each pass): the same

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <limits>
 #include <span>
+#include <utility>
 
 #include "core/huge_pages.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/partitioned_sweep.hpp"
 
 namespace febemesh::dim2 {
 namespace {
@@ -89,8 +91,6 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // when the node is searched from: the connectivity does not change here, and most nodes are
   // above the target and never searched (flange level 9: the lists of all nodes up front were
   // 80M instructions and 4 bytes per node at this stage's memory peak).
-  std::vector<std::int32_t> nbr;
-  std::vector<std::uint8_t> listed(n_nodes, 0);
 
   // Triangles measured against their own aim (q x target / triangle_target); 1 exactly when
   // there is none, so that one-kind meshes see angle_quality itself.
@@ -197,23 +197,48 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // settled[v]: the search from v found no better place and no node of v's elements has moved
   // since; it would search the same numbers again and is skipped.
   std::vector<std::uint8_t> settled(n_nodes, 0);
+  // The sweeps in slabs on threads (core/partitioned_sweep.hpp): a search from v reads v's
+  // elements and their nodes, and writes v, its elements' q and (marks) their nodes' settled.
+  struct alignas(64) Worker {
+    std::vector<std::int32_t> nbr;
+    std::vector<std::uint8_t> listed;  ///< append_polygon_neighbours' marks
+    std::size_t moves = 0;
+  };
+  const auto lock_of = [&](std::size_t v) -> std::uint8_t { return v < locked.size() ? locked[v] : 0; };
+  const std::vector<std::uint8_t> part = slab_parts<2>(m.points, default_sweep_parts, opt.n_threads);
+  const PartitionedSweep sweep(
+      part, default_sweep_parts, separators(part, m.solid, opt.n_threads),
+      [&](std::int32_t v) {
+        const std::uint8_t lock = lock_of(static_cast<std::size_t>(v));
+        return first[v] != first[v + 1] && lock != 1 && !(lock == 2 && !slide);
+      },
+      opt.n_threads);
+  std::vector<Worker> workers(static_cast<std::size_t>(sweep.n_threads()));
+  for (Worker& w : workers) w.listed.assign(n_nodes, 0);
   for (int round = 0; round < opt.rounds; ++round) {
-    std::size_t moved_this_round = 0;
-    for (std::size_t v = 0; v < n_nodes; ++v) {
-      if (first[v] == first[v + 1] || settled[v]) continue;
-      const std::uint8_t lock = v < locked.size() ? locked[v] : 0;
-      if (lock == 1 || (lock == 2 && !slide)) continue;
+    sweep.run([&](std::int32_t vi, int thread) {
+      Worker& my = workers[static_cast<std::size_t>(thread)];
+      const auto v = static_cast<std::size_t>(vi);
+      if (settled[v]) return;
+      const std::uint8_t lock = lock_of(v);
       double best_q = cached_worst(v);
-      if (best_q >= opt.target) continue;
+      if (best_q >= opt.target) {
+        // The same until a node of its elements moves (their q are all it read): skipped till
+        // then, as a search that found nothing (each round read every node's elements: 25 ms a
+        // round, most of this stage, flange at 5.4 M triangles).
+        settled[v] = 1;
+        return;
+      }
       const P2 start = m.points[v];
       // A candidate as the node would really sit there (on the curve for sliding nodes).
       auto place = [&](const P2& p) { return lock == 2 ? slide(static_cast<std::int32_t>(v), p) : p; };
       const bool bound_chords = lock == 2 && !chord_nbr.first.empty();
       const double chord_limit = bound_chords ? chord_deviation(v, start) : 0.0;
+      std::vector<std::int32_t>& nbr = my.nbr;
       nbr.clear();
       append_polygon_neighbours(m.solid, static_cast<std::int32_t>(v),
                                 std::span<const std::int32_t>(incident.data() + first[v], incident.data() + first[v + 1]),
-                                nbr, listed);
+                                nbr, my.listed);
       P2 best = start, centroid = P2::Zero();
       double h = 0.0;
       for (const std::int32_t w : nbr) {
@@ -248,14 +273,16 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
           q_elem[incident[k]] = scaled_quality(incident[k]);
           const ElemId id{incident[k]};
           const VertexId* ev = m.solid.nodes(id);
-          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) settled[ev[j].v] = 0;
+          for (int j = 0; j < m.solid.n_nodes_of(id); ++j) mark(settled[ev[j].v], 0);
         }
-        ++st.moves;
-        ++moved_this_round;
+        ++my.moves;
       } else {
         settled[v] = 1;
       }
-    }
+    }, [] {}, [&](std::int32_t v) { return settled[v] != 0; });
+    std::size_t moved_this_round = 0;
+    for (Worker& w : workers) moved_this_round += std::exchange(w.moves, 0);
+    st.moves += moved_this_round;
     if (moved_this_round == 0) break;
   }
   st.worst_after = mesh_worst();

@@ -34,8 +34,9 @@ struct AngleOptimiseOptions {
   /// its two BE chords stay as close to the curve as they were (the larger of the two chord
   /// midpoints' distances does not grow), so raising angles never costs boundary fidelity.
   std::function<double(const Point<2>&)> curve_distance;
-  /// Threads for the per-element set-up and the mesh's worst q (the sweeps run on one); the
-  /// same mesh for every count.
+  /// Threads for the per-element set-up, the mesh's worst q and the sweeps (in slabs,
+  /// core/partitioned_sweep.hpp; `slide` and curve_distance must then be safe to call
+  /// concurrently for different nodes); the same mesh for every count.
   int n_threads = 1;
 };
 

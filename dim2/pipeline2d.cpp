@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
 #include "core/quality.hpp"
+#include "core/partitioned_sweep.hpp"
 #include "core/smooth.hpp"
 #include "dim2/heap_policy.hpp"
 #include "dim2/improve2d.hpp"
@@ -120,19 +121,23 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       SmoothOptions<2> so;
       so.n_iterations = opt.smoothing_iterations;
       so.n_threads = opt.n_threads;
-      // The sweeps on one thread: most 2D visits find the node settled (min_move) and return,
-      // and scheduling them on the sweep's DAG cost more than the visits: flange at 5.4 M
-      // triangles, smoothing 0.45-0.74 s on one thread against 0.68-1.09 s on two, and the DAG
-      // was the 2-thread run's memory peak (114 against 95 bytes an element).
-      so.sweep_threads = 1;
+      // The sweeps in slabs (core/partitioned_sweep.hpp) on every thread: most 2D visits find
+      // the node settled (min_move) and return, and scheduling them in node order on the
+      // sweep's DAG cost more than the visits (flange at 5.4 M triangles, smoothing 0.45-0.74 s
+      // on one thread against 0.68-1.09 s on two; the DAG was the 2-thread memory peak).
+      so.parts = default_sweep_parts;
       // Rounding noise: a few ulps of the coordinates are ~1e-13 of an edge at level 10 and
       // ~3e-11 at level 17; real moves near the curve are far above it.
       so.min_move = 1e-10;
+      so.fixed.assign(fe.mesh.points.size(), 0);
       if (opt.slide_boundary) {
-        so.fixed.assign(fe.mesh.points.size(), 0);
         for (std::size_t v = 0; v < fe.where.size(); ++v)
           if (fe.where[v].kind == BoundaryLocation::Kind::Corner) so.fixed[v] = 1;
         so.project = [&](const Point<2>& p) { return Point<2>(curve.closest_point(p).point); };
+      } else {
+        // The solid's boundary is the BE mesh: its nodes stay, and smooth need not find them.
+        for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
+        so.boundary_fixed = true;
       }
       const SmoothStats ss = smooth(fe.mesh, so);
       r.n_smoothing_rejected = ss.moves_rejected;
