@@ -1,7 +1,10 @@
 #pragma once
 // Node -> item incidence lists in compressed rows, built on several threads (issue 8): each
-// thread counts and then fills the items of one contiguous range, so every node's list holds its
-// items in increasing order whatever the thread count (the serial lists).
+// thread owns a contiguous range of nodes and reads every item for them, filling their lists
+// from the back, so every node's list holds its items in increasing order whatever the thread
+// count (the serial lists), and nothing is allocated beside the result. (Per-thread counters
+// over all nodes, the earlier build, made two threads slower than one: 0.133 against 0.059 s
+// for the 2D smoothing's lists at flange 1e6, 2.7 M nodes; and were 16 B a node at 2 threads.)
 
 #include <algorithm>
 #include <cstddef>
@@ -19,32 +22,33 @@ namespace febemesh {
 template <class NodesOf>
 void incidence_csr(std::size_t n, std::size_t n_items, const NodesOf& nodes_of, int n_threads,
                    std::vector<std::int32_t>& start, std::vector<std::int32_t>& item) {
-  // Two parts a thread (for_each_range runs fewer than two chunks a thread on one thread).
-  const std::size_t n_parts = n_items < 65536 || n_threads <= 1 ? 1 : 2 * static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
-  const std::size_t chunk = std::max<std::size_t>(1, (n_items + n_parts - 1) / n_parts);
-  // cursor[c][v]: part c's count of node v's listings, then where part c writes its next one.
-  std::vector<std::vector<std::int32_t>> cursor(n_parts);
-  for_each_chunk(n_items, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    cursor[c].assign(n, 0);
-    for (std::size_t k = begin; k < end; ++k) nodes_of(k, [&](std::int32_t v) { ++cursor[c][static_cast<std::size_t>(v)]; });
-  });
-  for (auto& part : cursor) part.resize(n, 0);  // parts without items
+  const int n_workers = n_items < 65536 ? 1 : n_threads;
+  // use(k, v) for every listing of a node v in [lo, hi), items from the last to the first.
+  const auto each_owned = [&](std::size_t lo, std::size_t hi, auto&& use) {
+    if (lo == 0 && hi == n) {
+      for (std::size_t k = n_items; k-- > 0;) nodes_of(k, [&](std::int32_t v) { use(k, v); });
+      return;
+    }
+    for (std::size_t k = n_items; k-- > 0;)
+      nodes_of(k, [&](std::int32_t v) {
+        if (static_cast<std::size_t>(v) >= lo && static_cast<std::size_t>(v) < hi) use(k, v);
+      });
+  };
   reserve_huge(start, n + 1);
   start.assign(n + 1, 0);
-  for (std::size_t v = 0; v < n; ++v) {
-    std::int32_t at = start[v];
-    for (auto& part : cursor) {
-      const std::int32_t count = part[v];
-      part[v] = at;
-      at += count;
-    }
-    start[v + 1] = at;
-  }
-  reserve_huge(item, static_cast<std::size_t>(start[n]));
-  item.resize(static_cast<std::size_t>(start[n]));
-  for_each_chunk(n_items, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k)
-      nodes_of(k, [&](std::int32_t v) { item[static_cast<std::size_t>(cursor[c][static_cast<std::size_t>(v)]++)] = static_cast<std::int32_t>(k); });
+  for_each_range(n, n_workers, [&](std::size_t lo, std::size_t hi) {
+    each_owned(lo, hi, [&](std::size_t, std::int32_t v) { ++start[static_cast<std::size_t>(v)]; });
+  });
+  // start[v] = the end of v's list; the fill steps it down to the list's first slot.
+  std::int32_t at = 0;
+  for (std::size_t v = 0; v < n; ++v) start[v] = at += start[v];
+  start[n] = at;
+  reserve_huge(item, static_cast<std::size_t>(at));
+  item.resize(static_cast<std::size_t>(at));
+  for_each_range(n, n_workers, [&](std::size_t lo, std::size_t hi) {
+    each_owned(lo, hi, [&](std::size_t k, std::int32_t v) {
+      item[static_cast<std::size_t>(--start[static_cast<std::size_t>(v)])] = static_cast<std::int32_t>(k);
+    });
   });
 }
 

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/huge_pages.hpp"
+#include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/partitioned_sweep.hpp"
@@ -68,25 +69,16 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   AngleOptimiseStats st;
   const std::size_t n_nodes = m.points.size(), n_elems = m.solid.size();
 
-  // Node -> incident elements (CSR) and node -> edge neighbours (CSR, sorted, unique).
-  std::vector<std::int32_t> first;
-  reserve_huge(first, n_nodes + 1);
-  first.assign(n_nodes + 1, 0);
-  for (std::size_t e = 0; e < n_elems; ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    for (int k = 0; k < m.solid.n_nodes_of(id); ++k) ++first[m.solid.nodes(id)[k].v + 1];
-  }
-  for (std::size_t v = 0; v < n_nodes; ++v) first[v + 1] += first[v];
-  std::vector<std::int32_t> incident;
-  reserve_huge(incident, static_cast<std::size_t>(first.back()));
-  incident.resize(static_cast<std::size_t>(first.back()));
-  {
-    std::vector<std::int32_t> fill(first.begin(), first.end() - 1);  // (freed here: this is the run's memory peak)
-    for (std::size_t e = 0; e < n_elems; ++e) {
-      const ElemId id{static_cast<std::int32_t>(e)};
-      for (int k = 0; k < m.solid.n_nodes_of(id); ++k) incident[fill[m.solid.nodes(id)[k].v]++] = static_cast<std::int32_t>(e);
-    }
-  }
+  // Node -> incident elements (CSR, on threads; nothing beside the lists: this stage holds the
+  // 2D run's memory peak).
+  std::vector<std::int32_t> first, incident;
+  incidence_csr(
+      n_nodes, n_elems,
+      [&](std::size_t e, auto&& f) {
+        const ElemId id{static_cast<std::int32_t>(e)};
+        for (int k = 0; k < m.solid.n_nodes_of(id); ++k) f(m.solid.nodes(id)[k].v);
+      },
+      opt.n_threads, first, incident);
   // Edge neighbours of a node from its incident elements (append_polygon_neighbours), gathered
   // when the node is searched from: the connectivity does not change here, and most nodes are
   // above the target and never searched (flange level 9: the lists of all nodes up front were
