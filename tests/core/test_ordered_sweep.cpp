@@ -13,6 +13,7 @@
 
 #include "core/ordered_sweep.hpp"
 #include "property.hpp"
+#include "sweep_relaxation.hpp"
 
 using namespace febemesh;
 
@@ -80,34 +81,6 @@ void check_dag(const Graph& g, const std::vector<std::int32_t>& nodes, const Swe
     REQUIRE(std::vector<std::int32_t>(got.begin(), got.end()) == later);
     REQUIRE(d.n_earlier[i] == static_cast<std::int32_t>(earlier.size()));
   }
-}
-
-/// A nonlinear Gauss-Seidel sweep: x[v] moves towards its neighbours' mean unless it was
-/// settled, and a move marks its neighbours unsettled (like the smoothing's skip flags).
-struct Relaxation {
-  const Graph& g;
-  std::vector<double> x;
-  std::vector<std::uint8_t> settled;
-  void visit(std::int32_t v) {
-    const auto& nb = g.adj[static_cast<std::size_t>(v)];
-    if (settled[static_cast<std::size_t>(v)] || nb.empty()) return;
-    double mean = 0.0;
-    for (const std::int32_t u : nb) mean += x[static_cast<std::size_t>(u)];
-    mean /= static_cast<double>(nb.size());
-    const double target = std::sin(3.0 * mean) + 0.5 * x[static_cast<std::size_t>(v)];
-    if (std::abs(target - x[static_cast<std::size_t>(v)]) < 0.05) {
-      settled[static_cast<std::size_t>(v)] = 1;
-      return;
-    }
-    x[static_cast<std::size_t>(v)] = target;
-    for (const std::int32_t u : nb) mark(settled[static_cast<std::size_t>(u)], 0);
-  }
-};
-
-Relaxation start(const Graph& g) {
-  Relaxation r{g, std::vector<double>(g.size()), std::vector<std::uint8_t>(g.size(), 0)};
-  for (std::size_t v = 0; v < g.size(); ++v) r.x[v] = std::cos(static_cast<double>(v));
-  return r;
 }
 
 }  // namespace
@@ -178,14 +151,14 @@ TEST_CASE("an in-order sweep gives the serial numbers on any thread count", "[or
   for (const unsigned seed : {1u, 2u, 3u}) {
     const Graph g = random_graph(6000, seed, 4);
     const std::vector<std::int32_t> nodes = some_nodes(g.size());
-    Relaxation serial = start(g);
+    test::Relaxation serial(g.adj);
     for (int it = 0; it < 5; ++it)
       for (const std::int32_t v : nodes) serial.visit(v);
     for (const int threads : {1, 2, 3, 4}) {
       const OrderedSweep sweep(nodes, g.size(), threads, g.neighbours(), 0);
       CHECK(sweep.n_threads() == threads);
       CHECK(sweep.size() == nodes.size());
-      Relaxation r = start(g);
+      test::Relaxation r(g.adj);
       for (int it = 0; it < 5; ++it) sweep.run([&](std::int32_t v, int) { r.visit(v); });
       CAPTURE(seed, threads);
       CHECK(r.x == serial.x);  // bit for bit

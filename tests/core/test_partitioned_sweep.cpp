@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/partitioned_sweep.hpp"
+#include "sweep_relaxation.hpp"
 #include "test_mesh_fixtures.hpp"
 
 using namespace febemesh;
@@ -51,33 +52,6 @@ std::vector<std::vector<std::int32_t>> element_neighbours(const Mesh<2>& m) {
   return out;
 }
 
-/// A nonlinear Gauss-Seidel relaxation over element neighbours, with skip flags a move clears
-/// on its neighbours (as the 2D sweeps do).
-struct Relaxation {
-  const std::vector<std::vector<std::int32_t>>& nb;
-  std::vector<double> x;
-  std::vector<std::uint8_t> settled;
-  void visit(std::int32_t v) {
-    const auto& around = nb[static_cast<std::size_t>(v)];
-    if (settled[static_cast<std::size_t>(v)] || around.empty()) return;
-    double mean = 0.0;
-    for (const std::int32_t u : around) mean += x[static_cast<std::size_t>(u)];
-    mean /= static_cast<double>(around.size());
-    const double target = std::sin(3.0 * mean) + 0.5 * x[static_cast<std::size_t>(v)];
-    if (std::abs(target - x[static_cast<std::size_t>(v)]) < 0.05) {
-      settled[static_cast<std::size_t>(v)] = 1;
-      return;
-    }
-    x[static_cast<std::size_t>(v)] = target;
-    for (const std::int32_t u : around) mark(settled[static_cast<std::size_t>(u)], 0);
-  }
-};
-
-Relaxation start(const std::vector<std::vector<std::int32_t>>& nb) {
-  Relaxation r{nb, std::vector<double>(nb.size()), std::vector<std::uint8_t>(nb.size(), 0)};
-  for (std::size_t v = 0; v < nb.size(); ++v) r.x[v] = std::cos(static_cast<double>(v));
-  return r;
-}
 
 }  // namespace
 
@@ -159,7 +133,7 @@ TEST_CASE("a partitioned sweep gives its order's numbers on any thread count", "
     const std::vector<std::uint8_t> part = slab_parts<2>(m.points, default_sweep_parts, 1);
     const std::vector<std::uint8_t> sep = separators(part, m.solid, 1);
     const auto keep = [](std::int32_t v) { return v % 7 != 3; };
-    Relaxation serial = start(nb);
+    test::Relaxation serial(nb);
     {
       const PartitionedSweep one(part, default_sweep_parts, sep, keep, 1);
       for (int it = 0; it < 5; ++it)
@@ -168,7 +142,7 @@ TEST_CASE("a partitioned sweep gives its order's numbers on any thread count", "
     for (const int threads : {1, 2, 3, 4}) {
       const PartitionedSweep sweep(part, default_sweep_parts, sep, keep, threads);
       CHECK(sweep.n_threads() == threads);
-      Relaxation r = start(nb);
+      test::Relaxation r(nb);
       std::vector<std::size_t> visits(nb.size(), 0);
       std::size_t betweens = 0;
       for (int it = 0; it < 5; ++it)
