@@ -129,10 +129,11 @@ class PartitionedSweep {
   /// The separators, at the end of the order.
   std::size_t n_separators() const { return start_.back() - start_[start_.size() - 2]; }
 
-  /// visit(v, t) for every node in the order's result, t the thread (0 = the caller); the
-  /// parts' inner nodes on n_threads threads (a part to a thread that is free, in part order),
-  /// then between() on the caller, then the separators on the caller. Rethrows the first
-  /// exception (of the lowest thread) once every thread has stopped.
+  /// visit(v, t) for every node of the order but those with skip(v) (asked just before the
+  /// node's turn), with the result of visiting them in the order; t is the thread (0 = the
+  /// caller). The parts' inner nodes on n_threads threads (a part to a thread that is free, in
+  /// part order), then between() on the caller, then the separators on the caller. Rethrows
+  /// the first exception (of the lowest thread) once every thread has stopped.
   template <class Visit, class Between, class Skip> void run(const Visit& visit, const Between& between, const Skip& skip) const {
     // visit is called from this one place (so that it can be inlined here).
     const auto visit_groups = [&](std::size_t first, std::size_t last, int t) {

@@ -14,8 +14,8 @@
 #include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/ordered_sweep.hpp"
-#include "core/partitioned_sweep.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/partitioned_sweep.hpp"
 #include "core/quality.hpp"
 #include "core/sort_short.hpp"
 

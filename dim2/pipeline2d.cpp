@@ -6,8 +6,8 @@
 
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
-#include "core/quality.hpp"
 #include "core/partitioned_sweep.hpp"
+#include "core/quality.hpp"
 #include "core/smooth.hpp"
 #include "dim2/heap_policy.hpp"
 #include "dim2/improve2d.hpp"
@@ -121,10 +121,10 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       SmoothOptions<2> so;
       so.n_iterations = opt.smoothing_iterations;
       so.n_threads = opt.n_threads;
-      // The sweeps in slabs (core/partitioned_sweep.hpp) on every thread: most 2D visits find
-      // the node settled (min_move) and return, and scheduling them in node order on the
-      // sweep's DAG cost more than the visits (flange at 5.4 M triangles, smoothing 0.45-0.74 s
-      // on one thread against 0.68-1.09 s on two; the DAG was the 2-thread memory peak).
+      // The sweeps in slab order, on every thread (core/partitioned_sweep.hpp). In node order
+      // they ran on one thread: most 2D visits find the node settled (min_move) and return,
+      // and scheduling them on the node order's DAG cost more than the visits (flange at 5.4 M
+      // triangles, smoothing 0.45-0.74 s on one thread against 0.68-1.09 s on two).
       so.parts = default_sweep_parts;
       // Rounding noise: a few ulps of the coordinates are ~1e-13 of an edge at level 10 and
       // ~3e-11 at level 17; real moves near the curve are far above it.
