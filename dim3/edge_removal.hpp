@@ -4,7 +4,9 @@
 // the 2(m - 2) tetrahedra joining a and b to a triangulation of the m-gon of their other nodes
 // (the edge's link), chosen by Klincsek's dynamic programme to maximise the worst of them. At a
 // surface edge the link is open (m = n + 1) and closing it swaps the edge of the surface mesh:
-// the two interface triangles at ab become two at the link's ends.
+// the two interface triangles at ab become two at the link's ends. At a concave surface edge
+// (more than pi inside) the new tetrahedra also fill the tetrahedron of ab and the link's ends,
+// outside the old surface: the same as adding it and removing the edge, now inside.
 //
 // Node moves cannot open a wedge that the mesh's connectivity fixes: the dihedral angles of the
 // tetrahedra around an edge add up to the angle at the edge (2 pi inside, the surface mesh's
@@ -43,13 +45,29 @@ struct EdgeRemovalOptions {
   /// normals at its nodes does not drop, and stays positive), and never an edge between two
   /// feature-line or corner nodes (it may be the feature line itself).
   std::function<Point<3>(const BoundaryLocation&)> surface_normal;
+  /// Tetrahedra below this (degrees) that no other removal mends also try swapping their
+  /// concave surface edges (with surface_normal). 0: never. The new tetrahedra then fill the
+  /// tetrahedron between the old and the new interface triangles too, outside the old surface,
+  /// so only where no interface triangle reaches into it. Without them spool L4 kept two
+  /// tetrahedra at 14.33 deg: an interior node 0.003 from a surface edge of 0.046 along a
+  /// concave crease, whose two interface triangles (angles of 161 and 170 deg) met at 283 deg
+  /// inside; no node could move out of it (a search of the interior node's positions found
+  /// nothing better than 14.34), the swap makes the two tetrahedra 22.2 and 29.9 deg.
+  double concave_below_deg = 15.0;
   /// Tetrahedra below this (degrees) whose edges no removal mends try contracting an edge,
   /// shortest first. 0: never. A contraction is taken if it raises the worst angle of the
-  /// tetrahedra at the node it removes by min_gain_deg. Only nodes inside or on smooth surface
-  /// (where.kind Smooth) go, a surface node only into another surface node along an interface
-  /// edge, and then only if the new interface triangles fit the surface (as for a surface swap:
-  /// needs surface_normal). The mesh's nodes are renumbered (EdgeRemovalStats::node_map).
+  /// tetrahedra at the node it removes (contract_min_gain_deg). Only nodes inside or on smooth
+  /// surface (where.kind Smooth) go, a surface node only into another surface node along an
+  /// interface edge, and then only if the new interface triangles fit the surface (as for a
+  /// surface swap: needs surface_normal). The mesh's nodes are renumbered (EdgeRemovalStats::node_map).
   double contract_below_deg = 0.0;
+  /// A contraction is taken if it raises the worst angle of the tetrahedra at the removed node
+  /// by more than this (degrees). Not min_gain_deg: a contraction removes a node, so it cannot
+  /// come back, and the node moves after it lengthen the edges around the place. fandisk L6's
+  /// worst tetrahedron (14.84 deg) held a smooth surface edge of 0.0015 among edges of
+  /// 0.0085-0.018, whose contraction raised its node's worst angle by 0.09 deg: at 0.5 deg it
+  /// stayed; at 0 the sweeps after it took the mesh to 15.94 deg.
+  double contract_min_gain_deg = 0.0;
   /// Per node: 1 = never contracted away (the pipeline: the feature corners). Empty: none.
   std::vector<std::uint8_t> keep;
   /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
@@ -60,6 +78,7 @@ struct EdgeRemovalOptions {
 struct EdgeRemovalStats {
   std::size_t removed = 0;          ///< edges removed
   std::size_t surface_swapped = 0;  ///< of them, surface edges
+  std::size_t concave_swapped = 0;  ///< of those, concave ones (EdgeRemovalOptions::concave_below_deg)
   /// With `cell`: the cells (ascending, each once) that lost a tetrahedron, so whose
   /// tetrahedra are no longer their template's (make_hex_dominant leaves them as they are).
   std::vector<std::int32_t> cells_changed;

@@ -13,7 +13,8 @@
 //   other     - all projections go out and land facing the face: shear between neighbours.
 // Usage: diagnose3d SURFACE LEVEL [THICKNESS_CELLS] [options]  (--help lists them)
 // --pipeline runs the whole pipeline instead; with --quality it sorts the final mesh's tetrahedra
-// under 10 degrees (--below DEG) by where they come from (print_quality_diagnosis).
+// under 10 degrees (--below DEG) by where they come from (print_quality_diagnosis), and with
+// --dump N prints the N worst with their edges and their nodes' stars.
 // THICKNESS_CELLS sets Options3d::thickness_cells (the thickness level from the first tree, no
 // retry), capped at LEVEL + --thickness-extra N (default 2); --snap snaps to features here too.
 // --opposing drops the interior octants at nodes with opposing free faces (remove_opposing,
@@ -138,6 +139,40 @@ void print_quality_diagnosis(const Result3d& r, const SurfaceBoundary& s, int du
       std::printf(" %d(%d %.4f %.4f %.4f)", v[k].v, kind(v[k].v), m.points[v[k].v][0], m.points[v[k].v][1],
                   m.points[v[k].v][2]);
     std::printf("\n");
+    // Its edges (length, dihedral angle, on the surface mesh or not) and faces on the interface,
+    // and per node the worst angle of its star: which of its nodes the sweeps could still move.
+    const P3 p[4] = {m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]};
+    const std::array<double, 6> ang = tet_dihedral_angles_deg(p[0], p[1], p[2], p[3]);
+    std::printf("    edges (length deg):");
+    for (int k = 0; k < 6; ++k) {
+      const std::int32_t a = v[edge_nodes[k][0]].v, b = v[edge_nodes[k][1]].v;
+      std::printf(" %d-%d %.4f %.2f%s", a, b, (m.points[a] - m.points[b]).norm(), ang[k],
+                  surface_edges.count({std::min(a, b), std::max(a, b)}) ? "s" : "");
+    }
+    std::printf("\n    interface faces:");
+    for (std::size_t f = 0; f < m.interface.size(); ++f) {
+      const VertexId* fv = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+      int in = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 4; ++k) in += fv[i].v == v[k].v ? 1 : 0;
+      if (in == 3) std::printf(" (%d %d %d)", fv[0].v, fv[1].v, fv[2].v);
+    }
+    std::printf("\n");
+    for (int k = 0; k < 4; ++k) {
+      std::size_t n_star = 0;
+      std::vector<double> star;
+      for (std::size_t t = 0; t < m.solid.size(); ++t) {
+        const VertexId* u = m.solid.nodes(ElemId{static_cast<std::int32_t>(t)});
+        if (u[0].v != v[k].v && u[1].v != v[k].v && u[2].v != v[k].v && u[3].v != v[k].v) continue;
+        ++n_star;
+        const std::array<double, 6> a = tet_dihedral_angles_deg(m.points[u[0].v], m.points[u[1].v], m.points[u[2].v], m.points[u[3].v]);
+        star.push_back(*std::min_element(a.begin(), a.end()));
+      }
+      std::sort(star.begin(), star.end());
+      std::printf("    node %d: %zu tets, worst", v[k].v, n_star);
+      for (std::size_t i = 0; i < star.size() && i < 5; ++i) std::printf(" %.2f", star[i]);
+      std::printf("\n");
+    }
   }
 }
 
@@ -157,7 +192,9 @@ constexpr const char* usage =
     "  --thin-share          print the share of the surface thinner than 0.5-2 octants, and stop\n"
     "whole pipeline:\n"
     "  --pipeline            run mesh3d and print its verdict, tets, min dihedral, volume error\n"
-    "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin\n"
+    "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin;\n"
+    "                        --dump N prints the N worst: nodes, edges (length, angle), interface\n"
+    "                        faces and each node's worst angles\n"
     "  --single              one try, no fallbacks           --nosnap  no feature snapping\n"
     "  --accept-folds --peel-rounds N --buffer B --max-repairs N --island-refinements N\n"
     "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N\n"

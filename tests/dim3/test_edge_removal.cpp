@@ -1,6 +1,8 @@
 // edge_removal: removing an edge keeps the region filled (inside: the same volume; at a convex
 // surface edge: less by the tetrahedron cut off), inverts nothing and raises the worst angle; the
-// surface edge of anchor level 5 that held its five tetrahedra under 10 deg is swapped. Edge
+// surface edge of anchor level 5 that held its five tetrahedra under 10 deg is swapped; a
+// concave surface edge is swapped (the region grows by the tetrahedron outside it) unless another
+// part of the surface reaches into that tetrahedron. Edge
 // contraction removes the node of a short edge, inside or on the surface, and leaves a valid
 // mesh (the validator: conforming, interface = boundary, no unused node) of the same volume.
 
@@ -225,6 +227,77 @@ P3 cube_normal(const BoundaryLocation& w) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Tetrahedra (positive or not: they are turned) and their boundary faces as interface
+/// triangles, outward; every node on surface patch 0 but `inside`.
+Mesh<3> tets_with_hull(const std::vector<P3>& points, std::vector<std::array<std::int32_t, 4>> tets, std::int32_t inside,
+                       std::vector<BoundaryLocation>& where) {
+  Mesh<3> m;
+  for (const P3& x : points) m.add_point(x);
+  std::map<std::array<std::int32_t, 3>, std::pair<int, std::array<std::int32_t, 3>>> faces;  // sorted -> (uses, outward)
+  for (auto& t : tets) {
+    if ((points[t[1]] - points[t[0]]).dot((points[t[2]] - points[t[0]]).cross(points[t[3]] - points[t[0]])) < 0) std::swap(t[2], t[3]);
+    m.solid.add(ElemType::Tet4, {VertexId{t[0]}, VertexId{t[1]}, VertexId{t[2]}, VertexId{t[3]}});
+    static const int face[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+    for (const auto& f : face) {
+      const std::array<std::int32_t, 3> o = {t[f[0]], t[f[1]], t[f[2]]};
+      std::array<std::int32_t, 3> k = o;
+      std::sort(k.begin(), k.end());
+      auto& e = faces[k];
+      ++e.first;
+      e.second = o;
+    }
+  }
+  for (const auto& [k, e] : faces)
+    if (e.first == 1) m.interface.add(ElemType::Tri3, {VertexId{e.second[0]}, VertexId{e.second[1]}, VertexId{e.second[2]}});
+  where.assign(points.size(), BoundaryLocation{});
+  for (std::size_t v = 0; v < points.size(); ++v) where[v].patch = static_cast<std::int32_t>(v) == inside ? -1 : 0;
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("a concave surface edge is swapped unless the surface reaches into what it adds", "[edge_removal]") {
+  // Surface edge ab (x from 0 to 1) between the interface triangles abc (in y = 0) and abf (in
+  // z = 0), 270 deg inside, two tetrahedra of 25 deg around it with the inside node i; the
+  // surface is the plane y + z = 0 (the interface folds where it has no crease; spool L4's worst
+  // two tetrahedra, 14.33 deg, sat around such an edge). The swap ab -> cf adds the tetrahedron
+  // a b f c (volume 0.015) and leaves two of 52.4 deg.
+  const std::vector<P3> points = {P3(0, 0, 0), P3(1, 0, 0), P3(0.5, 0, 0.3), P3(0.5, 0.3, 0), P3(0.5, -0.2, -0.2),
+                                  // A separate tetrahedron with its node 5 inside a b f c.
+                                  P3(0.5, 0.05, 0.05), P3(0.5, 0.6, 0.6), P3(0.9, 0.6, 0.6), P3(0.5, 0.9, 0.6)};
+  const std::int32_t a = 0, b = 1, c = 2, f = 3, i = 4;
+  const auto normal = [](const BoundaryLocation&) { return P3(0, 1, 1).normalized(); };
+  std::vector<BoundaryLocation> where;
+  EdgeRemovalOptions eo;
+  eo.surface_normal = normal;
+  eo.concave_below_deg = 30.0;
+  SECTION("swapped") {
+    Mesh<3> m = tets_with_hull({points.begin(), points.begin() + 5}, {{a, b, c, i}, {a, b, i, f}}, i, where);
+    const double before = min_dihedral(m), vol = total_volume6(m);
+    const EdgeRemovalStats st = remove_bad_edges(m, where, nullptr, eo);
+    INFO("min dihedral " << before << " -> " << min_dihedral(m) << " deg");
+    CHECK(st.concave_swapped == 1);
+    CHECK(min_dihedral(m) > before + 20.0);
+    CHECK(std::abs(total_volume6(m) - vol - 6 * 0.015) < 1e-12);
+    CHECK(m.interface.size() == 6);
+    CHECK(faces_match(m));
+    CHECK(validate(m, ValidateOptions<3>{}).valid);
+  }
+  SECTION("not with concave_below_deg 0") {
+    Mesh<3> m = tets_with_hull({points.begin(), points.begin() + 5}, {{a, b, c, i}, {a, b, i, f}}, i, where);
+    eo.concave_below_deg = 0.0;
+    CHECK(remove_bad_edges(m, where, nullptr, eo).concave_swapped == 0);
+  }
+  SECTION("not when another part of the surface reaches into it") {
+    Mesh<3> m = tets_with_hull(points, {{a, b, c, i}, {a, b, i, f}, {5, 6, 7, 8}}, i, where);
+    const EdgeRemovalStats st = remove_bad_edges(m, where, nullptr, eo);
+    CHECK(st.concave_swapped == 0);
+    CHECK(faces_match(m));
+  }
+}
 
 TEST_CASE("edge contraction removes the node of a short edge", "[edge_removal]") {
   // Grid node ids: x + 5 (y + 5 z).

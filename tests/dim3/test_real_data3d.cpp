@@ -128,11 +128,13 @@ TEST_CASE("mesh3d data: spool level 4 (its thin flanges kept by the thickness re
   // dihedral 2.59 deg, volume error 3.22%). Its 4 tetrahedra under 10 deg stood on interface
   // caps at a concave feature line; with the nodes pushed off it and the optimiser's moves along
   // creases: 10.24 deg, 3.17% (issue 6 asks for 10 deg); with the feature-line nodes sliding
-  // along their lines (session h1): 14.30 deg, 3.17%.
+  // along their lines (session h1): 14.30 deg, 3.17%. Its worst two then sat around a concave
+  // surface edge (283 deg inside); with concave surface swaps (edge_removal, session 23): 20.00
+  // deg, 3.16% (CLI), at issue 6's bar.
   const DataRun d = mesh_and_validate("spool", 4);
   CHECK(d.thickness_refined);
   CHECK(!d.facing_projection);
-  CHECK(d.min_dihedral_deg >= 14.0);
+  CHECK(d.min_dihedral_deg >= 15.0);
   CHECK(d.volume_rel_error < 0.05);
 }
 
