@@ -205,6 +205,7 @@ int run(const std::vector<std::string>& argv) {
                    {"optimize_moves", r.n_optimize_moves},
                    {"edges_removed", r.n_edges_removed},
                    {"edges_contracted", r.n_edges_contracted},
+                   {"concave_surface_swaps", r.n_concave_swaps},
                    {"corners_snapped", r.stats.n_corners_snapped},
                    {"corners_missed", r.stats.n_corners_missed},
                    {"edge_nodes_snapped", r.stats.n_edge_snapped},

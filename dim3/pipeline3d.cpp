@@ -1002,6 +1002,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
             r.n_edges_removed += es.removed;
             r.n_edges_contracted += es.contracted;
+            r.n_concave_swaps += es.concave_swapped;
             for (auto* per_node : {&corners, &to.fixed, &to.on_line}) remap_nodes(es.node_map, *per_node);
             remap_nodes(es.node_map, fe.where);
             if (!es.node_map.empty()) {  // the template's node ids -> today's (make_hex_dominant)

@@ -186,6 +186,7 @@ struct Result3d {
   std::size_t n_optimize_moves = 0;  ///< node moves of the dihedral-angle optimisation
   std::size_t n_edges_removed = 0;   ///< edges removed after it (remove_edges_below_deg)
   std::size_t n_edges_contracted = 0;  ///< edges contracted there (contract_edges_below_deg)
+  std::size_t n_concave_swaps = 0;  ///< of the edges removed, concave surface edges (EdgeRemovalOptions::concave_below_deg)
   HexDominantStats hex;              ///< with opt.hex_dominant
   std::vector<StageTime3> times;
 };

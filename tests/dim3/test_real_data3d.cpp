@@ -77,6 +77,7 @@ struct DataRun {
   double min_dihedral_deg = 0.0;
   double volume_rel_error = 1.0;
   std::size_t edges_contracted = 0;
+  std::size_t concave_swaps = 0;
 };
 
 DataRun mesh_and_validate(const std::string& name, const Options3d& opt) {
@@ -95,7 +96,7 @@ DataRun mesh_and_validate(const std::string& name, const Options3d& opt) {
   CHECK(f.max_node_distance <= vo.boundary_tolerance);
   CHECK(f.volume_rel_error < 0.25);
   return {r.buffer_dropped, r.facing_projection, r.thickness_refined, r.features_dropped, q.min_angle_deg,
-          f.volume_rel_error, r.n_edges_contracted};
+          f.volume_rel_error, r.n_edges_contracted, r.n_concave_swaps};
 }
 
 DataRun mesh_and_validate(const std::string& name, int level, int max_repairs = 2, bool retry_facing = true,
@@ -135,6 +136,7 @@ TEST_CASE("mesh3d data: spool level 4 (its thin flanges kept by the thickness re
   CHECK(d.thickness_refined);
   CHECK(!d.facing_projection);
   CHECK(d.min_dihedral_deg >= 15.0);
+  CHECK(d.concave_swaps > 0);  // what lifts it there
   CHECK(d.volume_rel_error < 0.05);
 }
 
