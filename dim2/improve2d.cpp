@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <set>
 #include <span>
 #include <utility>
 
@@ -265,6 +264,13 @@ struct Memo {
   void clear() { std::fill(elem.begin(), elem.end(), -1); }
 };
 
+/// Whether a flip's four nodes lie in two slabs or more (then they all become separators, in
+/// improve_mesh and its twin).
+bool spans_parts(const std::vector<std::uint8_t>& part, std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
+  const std::uint8_t p = part[static_cast<std::size_t>(a)];
+  return part[static_cast<std::size_t>(b)] != p || part[static_cast<std::size_t>(c)] != p || part[static_cast<std::size_t>(d)] != p;
+}
+
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
 int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -421,11 +427,6 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // nodes still share no element), instead of a pass over all elements after each round's
   // flips (2.4% of a flange run at 5.4 M triangles).
   std::vector<std::uint8_t> sep = separators(part, m.solid, n_threads);
-  const auto flip_crosses = [&](std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
-    return part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(b)] ||
-           part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(c)] ||
-           part[static_cast<std::size_t>(a)] != part[static_cast<std::size_t>(d)];
-  };
   std::vector<Worker> workers(static_cast<std::size_t>(std::max(1, n_threads)));
   for (Worker& w : workers) w.listed.assign(n_nodes, 0);
   Memo& memo0 = workers[0].memo;
@@ -502,7 +503,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
         maybe_bad_to(unsure, e0), maybe_bad_to(unsure, e1);
         forget_in(memo0, e0), forget_in(memo0, e1);
         flipped.push_back({e0, e1, a, b, c, d});
-        if (flip_crosses(a, b, c, d) && !(sep[a] && sep[b] && sep[c] && sep[d])) {
+        if (spans_parts(part, a, b, c, d) && !(sep[a] && sep[b] && sep[c] && sep[d])) {
           sep[a] = sep[b] = sep[c] = sep[d] = 1;
           new_separators = true;
         }
@@ -718,8 +719,7 @@ ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locke
         // New triangles (c, a, d) and (d, b, c): both positive since after > before >= -1.
         v0[0] = VertexId{c}, v0[1] = VertexId{a}, v0[2] = VertexId{d};
         v1[0] = VertexId{d}, v1[1] = VertexId{b}, v1[2] = VertexId{c};
-        const std::set<std::uint8_t> parts{part[a], part[b], part[c], part[d]};
-        if (parts.size() > 1) sep[a] = sep[b] = sep[c] = sep[d] = 1;
+        if (spans_parts(part, a, b, c, d)) sep[a] = sep[b] = sep[c] = sep[d] = 1;
         touched[e0] = touched[e1] = 1;
         angle[e0] = tri_min_angle(pc, pa, pd);
         angle[e1] = tri_min_angle(pd, pb, pc);
