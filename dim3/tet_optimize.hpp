@@ -96,6 +96,9 @@ double tet_search_quality(const Point<3>& a, const Point<3>& b, const Point<3>& 
 /// dihedral angle; inverted and flat ones as tet_search_quality (<= -1).
 double tet_search_rank(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
 
+/// tet_search_rank of a positive tetrahedron whose smallest dihedral angle is `angle` radians.
+double tet_search_rank_of_angle(double angle);
+
 /// Smallest dihedral angle of a tetrahedron in degrees (0 when flat); sign-free.
 double tet_min_dihedral_deg(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
 
