@@ -46,6 +46,11 @@ class SpillBuffer {
 
  protected:
   bool has_file() const { return file_ != nullptr; }
+  /// Writes `s` to the file at once, past the buffer (which the caller has flushed).
+  void write_through(std::string_view s) {
+    if (!s.empty() && std::fwrite(s.data(), 1, s.size(), file_) != s.size())
+      throw InputError("cannot write " + path_ + ": " + std::strerror(errno));
+  }
   // The text is written through a cursor into a buffer sized once (grown only when no file
   // takes it, or a field overruns a chunk): std::string::append and push_back per field, with
   // their capacity checks and calls, were 2% of the CLI's instructions (flange level 9).

@@ -3,13 +3,20 @@
 
 #include "core/write_msh.hpp"
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <charconv>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <string_view>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -19,6 +26,33 @@
 namespace febemesh {
 
 namespace {
+
+/// The shortest round-trip text of a double (std::to_chars), remembered per bit pattern: most
+/// nodes sit on the lattice, whose few coordinates repeat (flange level 9: 344k coordinates,
+/// 68k distinct), and std::to_chars was 5% of bench_mesh2d's instructions.
+class RealTexts {
+ public:
+  std::string_view text(double v) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    Text& t = texts_[(bits * 0x9E3779B97F4A7C15ull) >> (64 - log2_texts)];
+    if (t.len == 0 || t.bits != bits) {
+      t.bits = bits;
+      t.len = static_cast<std::uint8_t>(std::to_chars(t.text, t.text + sizeof t.text, v).ptr - t.text);
+    }
+    return {t.text, t.len};
+  }
+
+ private:
+  /// A remembered number: len == 0 marks an empty slot (no number prints as nothing).
+  struct Text {
+    std::uint64_t bits = 0;
+    std::uint8_t len = 0;
+    char text[31];  ///< a double's shortest text has at most 24 chars
+  };
+  static constexpr int log2_texts = 13;
+  std::unique_ptr<Text[]> texts_ = std::make_unique<Text[]>(std::size_t{1} << log2_texts);  ///< direct-mapped by the bits' multiplicative hash
+};
 
 /// MSH fields as text or bytes; with a file it spills every few MiB (SpillBuffer).
 class Sink : public SpillBuffer {
@@ -66,34 +100,108 @@ class Sink : public SpillBuffer {
     append_number(v);
     return *this;
   }
-  /// The shortest round-trip text of v (std::to_chars), remembered per bit pattern: most
-  /// nodes sit on the lattice, whose few coordinates repeat (flange level 9: 344k coordinates,
-  /// 68k distinct), and std::to_chars was 5% of bench_mesh2d's instructions.
   Sink& real(double v) {
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    if (!texts_) texts_ = std::make_unique<Text[]>(n_texts);
-    Text& t = texts_[(bits * 0x9E3779B97F4A7C15ull) >> (64 - log2_texts)];
-    if (t.len == 0 || t.bits != bits) {
-      t.bits = bits;
-      t.len = static_cast<std::uint8_t>(std::to_chars(t.text, t.text + sizeof t.text, v).ptr - t.text);
-    }
-    put(std::string_view(t.text, t.len));
+    if (!texts_) texts_ = std::make_unique<RealTexts>();
+    put(texts_->text(v));
     return *this;
+  }
+  /// Text formatted elsewhere (parallel_lines), appended in one piece: with a file, what is
+  /// buffered goes first and then `text` straight from its own buffer.
+  void put_block(std::string_view text) {
+    if (!has_file()) {
+      put(text);
+      return;
+    }
+    flush();
+    write_through(text);
   }
 
  private:
-  /// A remembered number: len == 0 marks an empty slot (no number prints as nothing).
-  struct Text {
-    std::uint64_t bits = 0;
-    std::uint8_t len = 0;
-    char text[31];  ///< a double's shortest text has at most 24 chars
-  };
-  static constexpr int log2_texts = 13;
-  static constexpr std::size_t n_texts = std::size_t{1} << log2_texts;
   bool binary_;
-  std::unique_ptr<Text[]> texts_;  ///< direct-mapped by the bits' multiplicative hash
+  std::unique_ptr<RealTexts> texts_;
 };
+
+/// Lines of text formatted into a buffer of their own (a block of parallel_lines).
+class LineBlock {
+ public:
+  /// Room for at least n more bytes at the end; write there, then end(p).
+  char* room(std::size_t n) {
+    if (capacity_ - size_ < n) {
+      const std::size_t capacity = std::max(2 * capacity_, size_ + n);
+      std::unique_ptr<char[]> bigger(new char[capacity]);
+      if (size_ != 0) std::memcpy(bigger.get(), buf_.get(), size_);
+      buf_ = std::move(bigger);
+      capacity_ = capacity;
+    }
+    return buf_.get() + size_;
+  }
+  void end(const char* p) { size_ = static_cast<std::size_t>(p - buf_.get()); }
+  std::string_view text() const { return {buf_.get(), size_}; }
+  void clear() { size_ = 0; }
+  RealTexts& reals() { return reals_; }
+
+ private:
+  std::unique_ptr<char[]> buf_;
+  std::size_t size_ = 0, capacity_ = 0;
+  RealTexts reals_;
+};
+
+/// Items per block of parallel_lines: ~0.5-1 MiB of text (30-60 bytes a line).
+constexpr std::size_t lines_per_block = 1 << 14;
+
+/// The text of items [0, count), in blocks of lines_per_block items: format(block, begin, end)
+/// appends the lines of items [begin, end) to the block. On n_threads threads each takes the
+/// next block, formats it, waits for the block before it to be written and writes its own
+/// (Sink::put_block), so that one thread writes while the other formats. The blocks do not
+/// depend on n_threads: the same text. The first exception stops the others once their block
+/// is done and is rethrown.
+template <class Format> void parallel_lines(Sink& out, std::size_t count, int n_threads, const Format& format) {
+  const std::size_t n_blocks = (count + lines_per_block - 1) / lines_per_block;
+  const auto range = [&](std::size_t k, auto&& f) { f(k * lines_per_block, std::min(count, (k + 1) * lines_per_block)); };
+  const int n_workers = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(std::clamp(n_threads, 1, 256)), n_blocks));
+  if (n_workers <= 1) {
+    LineBlock block;
+    for (std::size_t k = 0; k < n_blocks; ++k) {
+      block.clear();
+      range(k, [&](std::size_t begin, std::size_t end) { format(block, begin, end); });
+      out.put_block(block.text());
+    }
+    return;
+  }
+  std::atomic<std::size_t> next{0};
+  std::mutex m;
+  std::condition_variable cv;
+  std::size_t written = 0;  // blocks [0, written) are out
+  bool failed = false;
+  std::exception_ptr error;
+  const auto work = [&] {
+    LineBlock block;
+    try {
+      for (std::size_t k; (k = next.fetch_add(1)) < n_blocks;) {
+        block.clear();
+        range(k, [&](std::size_t begin, std::size_t end) { format(block, begin, end); });
+        std::unique_lock<std::mutex> lock(m);
+        cv.wait(lock, [&] { return written == k || failed; });
+        if (failed) return;
+        lock.unlock();  // the block's turn: no other thread writes until it is done
+        out.put_block(block.text());
+        lock.lock();
+        ++written;
+        cv.notify_all();
+      }
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(m);
+      if (!failed) error = std::current_exception();
+      failed = true;
+      cv.notify_all();
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < n_workers; ++t) threads.emplace_back(work);
+  work();
+  for (std::thread& th : threads) th.join();
+  if (error) std::rethrow_exception(error);
+}
 
 template <int Dim> void bbox_line(Sink& out, const Mesh<Dim>& mesh, const Elements& els) {
   Box<Dim> b = Box<Dim>::empty();
@@ -191,33 +299,42 @@ class NodeTagTexts {
 };
 
 template <int Dim> void write_blocks(Sink& out, const Elements& els, int entity_dim, std::int64_t first_tag,
-                  const NodeTagTexts& node_tags) {
-  constexpr int max_line_nodes = 8;
-  TagCounter tags;
+                  const NodeTagTexts& node_tags, int n_threads) {
   for (int t = 0; t <= static_cast<int>(ElemType::Pyramid5); ++t) {
     const auto type = static_cast<ElemType>(t);
     std::size_t count = 0;
     for (const ElemType et : els.type) count += (et == type);
     if (count == 0) continue;
     out.i32(entity_dim).i32(1).i32(gmsh_type(type)).size(count, '\n');
+    if (!out.binary()) {
+      // Each line built whole in the block (tag, node tags): the per-field calls were most of
+      // the element blocks' cost (flange level 9). Blocks by element index, the lines of this
+      // type among them.
+      const std::size_t line_bytes = static_cast<std::size_t>(n_nodes(type) + 1) * 21 + 1;
+      parallel_lines(out, els.size(), n_threads, [&](LineBlock& b, std::size_t begin, std::size_t end) {
+        TagCounter tags;
+        char* p = b.room((end - begin) * line_bytes);
+        for (std::size_t e = begin; e < end; ++e) {
+          if (els.type[e] != type) continue;
+          const ElemId id{static_cast<std::int32_t>(e)};
+          const int n = els.n_nodes_of(id);
+          const VertexId* v = els.nodes(id);
+          p = tags.put(p, static_cast<std::uint64_t>(first_tag) + e);
+          for (int i = 0; i < n; ++i) {
+            *p++ = ' ';
+            p = node_tags.put(p, static_cast<std::uint64_t>(v[i].v) + 1);
+          }
+          *p++ = '\n';
+        }
+        b.end(p);
+      });
+      continue;
+    }
     for (std::size_t e = 0; e < els.size(); ++e) {
       if (els.type[e] != type) continue;
       const ElemId id{static_cast<std::int32_t>(e)};
       const int n = els.n_nodes_of(id);
       const VertexId* v = els.nodes(id);
-      if (!out.binary() && n <= max_line_nodes) {
-        // A text line built whole and appended once: the per-field calls were most of the
-        // element blocks' cost (flange level 9).
-        char line[(max_line_nodes + 1) * 21 + 1];
-        char* p = tags.put(line, static_cast<std::uint64_t>(first_tag) + e);
-        for (int i = 0; i < n; ++i) {
-          *p++ = ' ';
-          p = node_tags.put(p, static_cast<std::uint64_t>(v[i].v) + 1);
-        }
-        *p++ = '\n';
-        out << std::string_view(line, static_cast<std::size_t>(p - line));
-        continue;
-      }
       out.size(static_cast<std::uint64_t>(first_tag) + e, n == 0 ? '\n' : ' ');
       for (int i = 0; i < n; ++i) out.size(static_cast<std::uint64_t>(v[i].v) + 1, i + 1 == n ? '\n' : ' ');
       out.maybe_flush();
@@ -233,7 +350,7 @@ std::size_t n_types(const Elements& els) {
   return n;
 }
 
-template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh) {
+template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh, int n_threads) {
   if (out.binary()) {
     out << "$MeshFormat\n4.1 1 8\n";
     out.raw(std::int32_t{1});  // lets a reader detect the byte order
@@ -272,17 +389,34 @@ template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh) {
         out.size(i + 1, '\n');
         out.maybe_flush();
       }
-    } else {
-      for (std::size_t i = 0; i < n; ++i) {
-        char line[32];
-        char* p = node_tags.put(line, i + 1);
-        *p++ = '\n';
-        out << std::string_view(line, static_cast<std::size_t>(p - line));
+      for (const auto& p : mesh.points) {
+        out.f64(p[0]).f64(p[1]).f64(Dim == 3 ? p[Dim - 1] : 0.0, '\n');
+        out.maybe_flush();
       }
-    }
-    for (const auto& p : mesh.points) {
-      out.f64(p[0]).f64(p[1]).f64(Dim == 3 ? p[Dim - 1] : 0.0, '\n');
-      out.maybe_flush();
+    } else {
+      parallel_lines(out, n, n_threads, [&](LineBlock& b, std::size_t begin, std::size_t end) {
+        char* p = b.room((end - begin) * 22);  // a tag: up to 20 digits (8 bytes copied), '\n'
+        for (std::size_t i = begin; i < end; ++i) {
+          p = node_tags.put(p, i + 1);
+          *p++ = '\n';
+        }
+        b.end(p);
+      });
+      // x y z: each the shortest text that reads back as the double (z = 0 in 2D).
+      parallel_lines(out, n, n_threads, [&](LineBlock& b, std::size_t begin, std::size_t end) {
+        RealTexts& reals = b.reals();
+        char* p = b.room((end - begin) * 3 * 32);
+        for (std::size_t i = begin; i < end; ++i) {
+          const Point<Dim>& x = mesh.points[i];
+          for (int d = 0; d < 3; ++d) {
+            const std::string_view t = reals.text(d < Dim ? x[d] : 0.0);
+            std::memcpy(p, t.data(), t.size());
+            p += t.size();
+            *p++ = d == 2 ? '\n' : ' ';
+          }
+        }
+        b.end(p);
+      });
     }
   }
   out << end_binary << "$EndNodes\n";
@@ -290,8 +424,8 @@ template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh) {
   const std::size_t ne = mesh.solid.size() + mesh.interface.size();
   out << "$Elements\n";
   out.size(n_types(mesh.solid) + n_types(mesh.interface)).size(ne).size(ne == 0 ? 0 : 1).size(ne, '\n');
-  write_blocks<Dim>(out, mesh.solid, Dim, 1, node_tags);
-  write_blocks<Dim>(out, mesh.interface, Dim - 1, static_cast<std::int64_t>(mesh.solid.size()) + 1, node_tags);
+  write_blocks<Dim>(out, mesh.solid, Dim, 1, node_tags, n_threads);
+  write_blocks<Dim>(out, mesh.interface, Dim - 1, static_cast<std::int64_t>(mesh.solid.size()) + 1, node_tags, n_threads);
   out << end_binary << "$EndElements\n";
 }
 
@@ -299,22 +433,23 @@ template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh) {
 
 template <int Dim> std::string msh_string(const Mesh<Dim>& mesh, MshEncoding encoding) {
   Sink out(encoding == MshEncoding::Binary);
-  write<Dim>(out, mesh);
+  write<Dim>(out, mesh, 1);
   return out.take();
 }
 
-template <int Dim> void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding) {
+template <int Dim>
+void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding, int n_threads) {
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "wb"), &std::fclose);
   if (!file) throw InputError("cannot open " + path.string() + " for writing: " + std::strerror(errno));
   Sink out(encoding == MshEncoding::Binary, file.get(), path.string());
-  write<Dim>(out, mesh);
+  write<Dim>(out, mesh, n_threads);
   out.flush();
   if (std::fflush(file.get()) != 0) throw InputError("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
 template std::string msh_string<2>(const Mesh<2>&, MshEncoding);
 template std::string msh_string<3>(const Mesh<3>&, MshEncoding);
-template void write_msh<2>(const Mesh<2>&, const std::filesystem::path&, MshEncoding);
-template void write_msh<3>(const Mesh<3>&, const std::filesystem::path&, MshEncoding);
+template void write_msh<2>(const Mesh<2>&, const std::filesystem::path&, MshEncoding, int);
+template void write_msh<3>(const Mesh<3>&, const std::filesystem::path&, MshEncoding, int);
 
 }  // namespace febemesh

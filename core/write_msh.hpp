@@ -19,8 +19,10 @@ namespace febemesh {
 enum class MshEncoding { Ascii, Binary };
 
 template <int Dim> std::string msh_string(const Mesh<Dim>& mesh, MshEncoding encoding = MshEncoding::Ascii);
-/// Throws InputError when the file cannot be written.
+/// Throws InputError when the file cannot be written. The text's node and element lines are
+/// formatted on n_threads threads, in blocks written in order (the same bytes for every count).
 template <int Dim>
-void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding = MshEncoding::Ascii);
+void write_msh(const Mesh<Dim>& mesh, const std::filesystem::path& path, MshEncoding encoding = MshEncoding::Ascii,
+               int n_threads = 1);
 
 }  // namespace febemesh

@@ -88,8 +88,8 @@ struct BaselineRun {
   double bytes_per_element() const { return elements ? double(peak_bytes) / double(elements) : 0.0; }
 };
 
-/// Times `body` (which returns the mesh) plus write_msh into dir/mesh.msh.
-template <int Dim, class Body> OurRun timed_run(const fs::path& dir, Body&& body) {
+/// Times `body` (which returns the mesh) plus write_msh into dir/mesh.msh on `threads` threads.
+template <int Dim, class Body> OurRun timed_run(const fs::path& dir, int threads, Body&& body) {
   OurRun run;
   fs::create_directories(dir);
   // A fresh file, as the CLI writes (into a new folder): overwriting the last run's mesh.msh
@@ -106,7 +106,7 @@ template <int Dim, class Body> OurRun timed_run(const fs::path& dir, Body&& body
   try {
     auto [mesh, times] = body();
     const auto tw = std::chrono::steady_clock::now();
-    write_msh<Dim>(mesh, dir / "mesh.msh");
+    write_msh<Dim>(mesh, dir / "mesh.msh", MshEncoding::Ascii, threads);
     const auto t1 = std::chrono::steady_clock::now();
     run.wall_seconds = std::chrono::duration<double>(t1 - t0).count();
     run.cpu_seconds = cpu_seconds() - c0;
@@ -124,7 +124,7 @@ template <int Dim, class Body> OurRun timed_run(const fs::path& dir, Body&& body
 
 inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir,
                           dim2::ElementKind elements = dim2::ElementKind::Tri) {
-  OurRun run = timed_run<2>(dir, [&] {
+  OurRun run = timed_run<2>(dir, threads, [&] {
     dim2::CurveBoundary curve = base;
     curve.set_global_level(level);
     dim2::Options2d opt;
@@ -140,7 +140,7 @@ inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int thr
 }
 
 inline OurRun run_ours_3d(const std::string& path, int level, int threads, const fs::path& dir) {
-  OurRun run = timed_run<3>(dir, [&] {
+  OurRun run = timed_run<3>(dir, threads, [&] {
     dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
     dim3::Options3d opt;
     opt.level = level;

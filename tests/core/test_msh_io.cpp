@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -109,6 +110,38 @@ TEMPLATE_TEST_CASE_SIG("write_msh writes the same bytes as msh_string", "[msh]",
   check_same(mesh, read_msh<Dim>(file));
   fs::remove(file);
   CHECK_THROWS_AS(write_msh(mesh, fs::path("/nonexistent-dir/x.msh")), InputError);
+}
+
+TEST_CASE("write_msh on several threads writes the bytes of one", "[msh]") {
+  // Triangles and quads interleaved (each type's block is cut by element index), on more than
+  // a few blocks of 16384 lines, with coordinates that are not on a lattice.
+  Mesh<2> mesh;
+  const int n = 210;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) mesh.add_point(Point<2>(i + 0.25 * std::sin(i * 7.0 + j), j + 0.25 * std::cos(j * 3.0 + i)));
+  const auto id = [&](int i, int j) { return VertexId{j * (n + 1) + i}; };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const VertexId a = id(i, j), b = id(i + 1, j), c = id(i + 1, j + 1), d = id(i, j + 1);
+      if ((i + j) % 3 == 0) {
+        mesh.solid.add(ElemType::Tri3, {a, b, c});
+        mesh.solid.add(ElemType::Tri3, {a, c, d});
+      } else {
+        mesh.solid.add(ElemType::Quad4, {a, b, c, d});
+      }
+    }
+  test::set_interface_to_boundary(mesh);
+  REQUIRE(mesh.solid.size() > 3 * 16384);
+  const std::string one = msh_string(mesh);
+  const fs::path file = temp_dir() / "threads.msh";
+  for (const int threads : {1, 2, 3, 8}) {
+    write_msh(mesh, file, MshEncoding::Ascii, threads);
+    CHECK(slurp(file) == one);
+  }
+  check_same(mesh, read_msh<2>(file));
+  fs::remove(file);
+  // A failing write stops every thread and throws (no hang, no crash).
+  if (fs::exists("/dev/full")) CHECK_THROWS_AS(write_msh(mesh, fs::path("/dev/full"), MshEncoding::Ascii, 2), InputError);
 }
 
 TEST_CASE("MSH reader reports malformed input with the line", "[msh]") {
