@@ -165,6 +165,29 @@ double facet_size(const Facet& f, const std::vector<Point<3>>& pts) {
   return h;
 }
 
+/// on_facet_interior for one triangle and many points: the triangle's normal once, and for
+/// each point the distance to its plane first (most points tested are off the plane, and then
+/// no barycentric coordinates are needed). The same numbers as barycentric(), so the same
+/// answers (the facet check was a third of the 3D validation: sphere966 level 6, 0.35 s of 1.1).
+class TriangleInterior {
+ public:
+  TriangleInterior(const Point<3>& a, const Point<3>& b, const Point<3>& c, double h, double rel)
+      : a_(a), b_(b), c_(c), n_((b - a).cross(c - a)), n2_(n_.squaredNorm()), root_(std::sqrt(n2_)), tol_(rel * h), rel_(rel),
+        none_(h == 0.0 || n2_ == 0.0) {}
+  bool contains(const Point<3>& p) const {
+    if (none_) return false;
+    if (!(std::abs((p - a_).dot(n_)) / root_ <= tol_)) return false;
+    const double l0 = (b_ - p).cross(c_ - p).dot(n_) / n2_;
+    const double l1 = (c_ - p).cross(a_ - p).dot(n_) / n2_;
+    return Eigen::Vector3d(l0, l1, 1.0 - l0 - l1).minCoeff() > rel_;
+  }
+
+ private:
+  Point<3> a_, b_, c_, n_;
+  double n2_, root_, tol_, rel_;
+  bool none_;  ///< a degenerate triangle (or facet size 0): no interior
+};
+
 /// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
 /// h is facet_size(f, pts), computed once per facet by the caller.
 bool on_facet_interior(const Point<3>& p, const Facet& f, double h, const std::vector<Point<3>>& pts, double rel) {
@@ -643,6 +666,13 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         const double h = facet_size(f, pts);  // once per facet, not once per node tested
         box.lo.array() -= rel * h;
         box.hi.array() += rel * h;
+        if (f.n == 3) {
+          const TriangleInterior tri(pts[f.node[0].v], pts[f.node[1].v], pts[f.node[2].v], h, rel);
+          grid.query(box, [&](std::int32_t c) {
+            if (c != f.node[0].v && c != f.node[1].v && c != f.node[2].v && tri.contains(pts[c])) at(c);
+          });
+          return;
+        }
         grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
