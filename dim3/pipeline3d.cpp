@@ -238,6 +238,19 @@ std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe
   return fixed;
 }
 
+/// Frees all of the complex but its snap marks (OctantComplex::snapped): its lattice, points,
+/// surface locations, projections and boundary octants, which the tetrahedra copied. Held
+/// beside the smoothing's lists they were 20 MB of sphere966 level 6's heap peak.
+void keep_snap_marks_only(OctantComplex& c) {
+  c.lattice = {};
+  std::vector<P3>().swap(c.points);
+  std::vector<BoundaryLocation>().swap(c.where);
+  std::vector<std::int32_t>().swap(c.projection);
+  std::vector<std::size_t>().swap(c.interior);
+  std::vector<BoundaryOctant>().swap(c.boundary);
+  std::vector<P3>().swap(c.unsnapped);
+}
+
 /// Lets the nodes snapped onto a feature line (and still on it) slide along it in the quality
 /// sweeps, and frees the snapped nodes now on a face (where.kind Smooth) as plain surface
 /// nodes: `to.fixed` releases both, `to.on_line` marks the line nodes and `to.slide` brings a
@@ -934,6 +947,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       clock.lap("templates");
     }
     if (problems.empty()) {
+      // From here on a tetrahedral mesh needs only the complex's snap marks (which nodes the
+      // sweeps keep fixed or slide along a line); the hex-dominant merge needs all of it.
+      if (!opt.hex_dominant) keep_snap_marks_only(oc.complex);
       say("smoothing: " + std::to_string(opt.smoothing_iterations) + " guarded Laplacian iterations");
       SmoothOptions<3> so;
       so.n_iterations = opt.smoothing_iterations;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 
 #include <Eigen/LU>
@@ -160,15 +161,27 @@ struct Optimizer {
   TetView tets;
   std::vector<std::int32_t> start, incident;  // CSR node -> tets
   /// Node -> neighbour nodes, listed only for the nodes a sweep visits (list_neighbours):
-  /// nbs[nb_begin[v], nb_end[v]), nb_begin[v] = -1 while v has none. All of them up front were
-  /// most of a call after edge removal (sphere966 L6: 0.08-0.12 s for 10^4 nodes to visit).
-  std::vector<std::int32_t> nb_begin, nb_end, nbs;
+  /// nb_count[v] of them at nb_list[v], null while v has none. All of them up front were most
+  /// of a call after edge removal (sphere966 L6: 0.08-0.12 s for 10^4 nodes to visit). Each
+  /// call's lists go in a block of their own, of their exact size: one array grown by resize
+  /// held up to twice its entries, and old and new at once while it grew (sphere966 L6: 13.9
+  /// MB for 4.7 MB of lists, at the pipeline's heap peak, heaptrack).
+  std::vector<const std::int32_t*> nb_list;
+  std::vector<std::int32_t> nb_count;
+  std::vector<std::unique_ptr<std::int32_t[]>> nb_blocks;
   std::span<const std::int32_t> neighbours(std::int32_t v) const {
-    return {nbs.data() + nb_begin[v], static_cast<std::size_t>(nb_end[v] - nb_begin[v])};
+    return {nb_list[v], static_cast<std::size_t>(nb_count[v])};
   }
   std::vector<std::array<std::int32_t, 3>> faces;  // interface triangles
   std::vector<std::int32_t> f_start, f_incident;   // CSR node -> interface triangles
-  std::vector<P3> node_normal;                     // surface normal at each surface node
+  /// The surface normal at each surface node: normals[normal_slot[v]], slot -1 (normal 0) for
+  /// the others (one a node was 6.1 MB at sphere966 L6 for 4% of the nodes on the surface).
+  std::vector<std::int32_t> normal_slot;
+  std::vector<P3> normals;
+  P3 node_normal(std::int32_t v) const {
+    const std::int32_t k = normal_slot.empty() ? -1 : normal_slot[v];
+    return k < 0 ? P3(P3::Zero()) : normals[static_cast<std::size_t>(k)];
+  }
   /// The search rank of every tetrahedron at the current points: tet_search_rank at the
   /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
   std::vector<double> tet_q;
@@ -193,7 +206,7 @@ struct Optimizer {
     for (int k = 0; k < 3; ++k) {
       const std::int32_t u = faces[f][k];
       p[k] = u == v ? x : mesh.points[u];
-      ref += u == v ? nx : node_normal[u];
+      ref += u == v ? nx : node_normal(u);
     }
     const double c = surface_alignment(p[0], p[1], p[2], ref);
     return c > 1e-9 ? std::numeric_limits<double>::infinity() : -2.0 + 0.5 * (1.0 + c);
@@ -277,7 +290,7 @@ struct Optimizer {
     const bool surf = is_surface(v);
     const bool guard = surf && !f_start.empty();
     const int inv0 = n_inverted_at(v, x0);
-    const int fold0 = guard ? n_folded_at(v, x0, node_normal[v]) : 0;
+    const int fold0 = guard ? n_folded_at(v, x0, node_normal(v)) : 0;
     P3 x = x0;
     BoundaryLocation w = surf ? where[v] : BoundaryLocation{};
     double k = escobar_sum(v, x, scale, delta);
@@ -292,7 +305,7 @@ struct Optimizer {
         g[d] = (escobar_sum(v, xp, scale, delta) - escobar_sum(v, xm, scale, delta)) / (2 * hd);
       }
       if (surf) {
-        const P3 n = node_normal.empty() ? P3::Zero() : P3(node_normal[v]);
+        const P3 n = node_normal(v);
         if (n.norm() > 0) g -= g.dot(n.normalized()) * n.normalized();
       }
       if (!(g.norm() > 0)) break;
@@ -321,10 +334,10 @@ struct Optimizer {
   /// that have none yet, appended to nbs.
   void list_neighbours(const std::vector<std::int32_t>& visit) {
     const std::size_t n = mesh.points.size();
-    if (nb_begin.empty()) nb_begin.assign(n, -1), nb_end.assign(n, -1);
+    if (nb_list.empty()) nb_list.assign(n, nullptr), nb_count.assign(n, 0);
     std::vector<std::int32_t> todo;
     for (const std::int32_t v : visit)
-      if (nb_begin[v] < 0) todo.push_back(v);
+      if (!nb_list[v]) todo.push_back(v);
     if (todo.empty()) return;
     // The distinct neighbours by marks (marks[u] == v), then sorted: the lists of sorting all
     // ~70 uses a node's tetrahedra make and keeping one of each (97 M instructions, sphere966
@@ -347,23 +360,20 @@ struct Optimizer {
       for (std::size_t i = begin; i < end; ++i) {
         std::int32_t count = 0;
         for_distinct(marks, todo[i], [&](std::int32_t) { ++count; });
-        nb_end[todo[i]] = count;
+        nb_count[todo[i]] = count;
       }
     });
-    std::size_t total = nbs.size();
-    for (const std::int32_t v : todo) {
-      nb_begin[v] = static_cast<std::int32_t>(total);
-      total += static_cast<std::size_t>(nb_end[v]);
-      nb_end[v] = static_cast<std::int32_t>(total);
-    }
-    MESH_ASSERT(total <= static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()), "too many neighbour entries");
-    nbs.resize(total);
+    std::size_t total = 0;
+    for (const std::int32_t v : todo) total += static_cast<std::size_t>(nb_count[v]);
+    nb_blocks.emplace_back(new std::int32_t[std::max<std::size_t>(total, 1)]);
+    std::int32_t* at = nb_blocks.back().get();
+    for (const std::int32_t v : todo) nb_list[v] = at, at += nb_count[v];
     ranges([&](std::vector<std::int32_t>& marks, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::int32_t v = todo[i];
-        std::int32_t out = nb_begin[v];
-        for_distinct(marks, v, [&](std::int32_t u) { nbs[out++] = u; });
-        sort_short(nbs.begin() + nb_begin[v], nbs.begin() + out);
+        std::int32_t* out = const_cast<std::int32_t*>(nb_list[v]);  // this call's own block
+        for_distinct(marks, v, [&](std::int32_t u) { *out++ = u; });
+        sort_short(const_cast<std::int32_t*>(nb_list[v]), out);
       }
     });
   }
@@ -410,12 +420,12 @@ struct Optimizer {
         if (planes[i].dot(u) > std::cos(pi / 6)) return;
       planes[n_planes++] = u;
     };
-    add_plane(node_normal[v]);
+    add_plane(node_normal(v));
     P3 ring = P3::Zero();
     int n_ring = 0;
     for (std::int32_t k = f_start[v]; k < f_start[v + 1]; ++k)
       for (const std::int32_t u : faces[f_incident[k]])
-        if (u != v) add_plane(node_normal[u]), ring += mesh.points[u], ++n_ring;
+        if (u != v) add_plane(node_normal(u)), ring += mesh.points[u], ++n_ring;
     if (n_planes < 2) return 0;  // smooth surface around v: the projected candidates do
     std::array<P3, 3> moves;
     int n_moves = 0;
@@ -445,7 +455,7 @@ struct Optimizer {
     double tets_worst = std::numeric_limits<double>::infinity();
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
       if (tet_q[incident[k]] < tets_worst) tets_worst = tet_q[incident[k]], worst_local = k - start[v];
-    const double f0 = std::min(tets_worst, guard ? faces_worst(v, x0, node_normal[v]) : 1e300);
+    const double f0 = std::min(tets_worst, guard ? faces_worst(v, x0, node_normal(v)) : 1e300);
     if (opt.untangle_only ? f0 > 0 : f0 >= target_rank) return false;
     double len = 0.0;
     const std::span<const std::int32_t> ring = neighbours(v);
@@ -528,7 +538,7 @@ struct Optimizer {
     // was not stopped early).
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) tet_q[incident[k]] = best_ranks[k - start[v]];
     if (surf) where[v] = best_w;
-    if (guard) node_normal[v] = opt.surface_normal(best_w);
+    if (guard) normals[static_cast<std::size_t>(normal_slot[v])] = opt.surface_normal(best_w);
     return true;
   }
 };
@@ -583,7 +593,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -591,9 +601,12 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   }
   o.tets = {mesh.solid.node.data(), mesh.solid.size()};  // the connectivity does not change here
   if (opt.surface_normal && opt.project) {
-    o.node_normal.assign(n, P3::Zero());
+    o.normal_slot.assign(n, -1);
     for (std::size_t v = 0; v < n && v < where.size(); ++v)
-      if (where[v].patch >= 0) o.node_normal[v] = opt.surface_normal(where[v]);
+      if (where[v].patch >= 0) {
+        o.normal_slot[v] = static_cast<std::int32_t>(o.normals.size());
+        o.normals.push_back(opt.surface_normal(where[v]));
+      }
     o.f_start.assign(n + 1, 0);
     for (std::size_t f = 0; f < mesh.interface.size(); ++f) {
       const VertexId* v = mesh.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
