@@ -69,7 +69,9 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   r.n_subdivided = tree.n_leaves();
   if (opt.keep_stages) r.subdivided = tree;
   say("quadrant generation: " + std::to_string(tree.n_leaves()) + " quadrants; one-level-difference rule");
-  tree = balance_2to1(tree, BalanceKind::Face);
+  BalanceOptions balancing;
+  balancing.n_threads = opt.n_threads;  // the same tree for every count
+  tree = balance_2to1(tree, BalanceKind::Face, balancing);
   clock.lap("balance");
   r.n_balanced = tree.n_leaves();
   if (opt.keep_stages) r.balanced = tree;
@@ -228,7 +230,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
         " place(s): " + describe(problems));
-    tree = balance_2to1(refine(tree, flags), BalanceKind::Face);
+    tree = balance_2to1(refine(tree, flags), BalanceKind::Face, balancing);
     clock.lap("repair refinement");
   }
 }

@@ -694,7 +694,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
   say("octree: " + std::to_string(tree.n_leaves()) + " octants; 2:1 balance");
   // Balanced across faces, edges and corners: every face of an octant then has at most one
   // level of hanging nodes, which the face templates assume.
-  tree = balance_2to1(tree, BalanceKind::Full);
+  BalanceOptions balancing;
+  balancing.n_threads = opt.n_threads;  // the same tree for every count
+  tree = balance_2to1(tree, BalanceKind::Full, balancing);
   clock.lap("balance");
   if (effort.limit == 0)
     effort.limit = std::max(static_cast<std::size_t>(opt.effort * static_cast<double>(tree.n_leaves())),
@@ -829,7 +831,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         ++island_refinements;
         say("interior octants: " + std::to_string(r.n_islands_dropped) + " in islands; refining " +
             std::to_string(n_marked) + " octants around them and on thin surface");
-        tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
+        tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
         clock.lap("island refinement");
         continue;
       }
@@ -1101,7 +1103,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
               ")");
           saved = Saved{r, tree, in, oc, std::move(fe), !topology_wrong};
           n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
-          tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
+          tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
           clock.lap("repair refinement");
           continue;
         }
@@ -1177,7 +1179,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
         " place(s): " + describe(problems));
-    tree = balance_2to1(refine(tree, flags), BalanceKind::Full);
+    tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
     peel_rounds = 0;
     clock.lap("repair refinement");
   }
