@@ -299,8 +299,7 @@ struct Projector {
   bool admissible(const P3& q, const P3& p, std::uint8_t dirs = 0, std::int32_t patch = -1) const {
     if (dirs != 0 && !leaves_outward(q, p, dirs, patch)) return false;
     if (segment_enters_kept(tree, in, q, p, graze)) return false;
-    const P3 short_end = q + (1.0 - 1e-7) * (p - q);
-    return !surface.segment_crosses(q, short_end);
+    return !surface.crosses_before(q, p);
   }
   /// Some free face f of q has cos(p - q, n_f) >= min_outward and cos(n_p, n_f) >= min_facing:
   /// a projection that runs back along the interior octants, or lands on the far side of a part

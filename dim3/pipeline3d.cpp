@@ -174,7 +174,7 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
     for (std::int32_t q : sources[p]) {
       const P3& from = oc.points[q];
       if (segment_enters_kept(t, in, from, x, graze)) return false;
-      if (s.segment_crosses(from, from + (1.0 - 1e-7) * (x - from))) return false;
+      if (s.crosses_before(from, x)) return false;
     }
     return true;
   };

@@ -104,6 +104,37 @@ void SurfaceBoundary::set_thickness_level(double cells, double max_level) {
   const std::vector<double>& thick = thicknesses();
   for (std::size_t t = 0; t < thick.size(); ++t)
     if (std::isfinite(thick[t]) && thick[t] > 0) thickness_level_[t] = std::log2(root_side_ * cells / thick[t]);
+  sample_begin_.clear();
+  sample_point_.clear();
+  sample_level_.clear();
+  sample_reach_.clear();
+  if (!options_.thickness_sampled) return;
+  // A grid of rays over each triangle whose thickness level passes the global level, spaced a
+  // quarter of its four-ray thickness (the finest octant of the cap at least).
+  const double finest = root_side_ / std::exp2(max_level);
+  sample_begin_.assign(surface_.n_triangles() + 1, 0);
+  sample_reach_.assign(surface_.n_triangles(), 0.0);
+  for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) {
+    sample_begin_[t] = static_cast<std::int32_t>(sample_point_.size());
+    if (!(thickness_level_[t] > options_.global_level)) continue;
+    const Triangle& tr = surface_.triangle(t);
+    const P3 &a = surface_.vertex(tr[0]), &b = surface_.vertex(tr[1]), &c = surface_.vertex(tr[2]);
+    const double edge = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    const double spacing = std::max(0.25 * thick[t], finest);
+    const int n = std::min(200, std::max(1, static_cast<int>(std::ceil(edge / spacing))));
+    sample_reach_[t] = edge / n;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const P3 p = a + (b - a) * (static_cast<double>(i) / n) + (c - a) * (static_cast<double>(j) / n);
+        const std::int32_t vertex = i == 0 && j == 0 ? tr[0] : i == n ? tr[1] : j == n ? tr[2] : -1;
+        const double th = thickness_from(t, p, vertex);
+        if (!(std::isfinite(th) && th > 0)) continue;
+        sample_point_.push_back(p);
+        sample_level_.push_back(std::log2(root_side_ * cells / th));
+        thickness_level_[t] = std::max(thickness_level_[t], sample_level_.back());
+      }
+  }
+  sample_begin_[surface_.n_triangles()] = static_cast<std::int32_t>(sample_point_.size());
 }
 
 double SurfaceBoundary::thickness_from(std::int32_t t, const P3& from_point, std::int32_t vertex) const {
@@ -290,6 +321,14 @@ bool SurfaceBoundary::segment_crosses(const P3& a, const P3& b) const {
   return crosses;
 }
 
+bool SurfaceBoundary::crosses_before(const P3& a, const P3& p) const {
+  const double len = (p - a).norm();
+  if (!(len > 0)) return false;
+  const double short_by = std::max(1e-7, 1e-9 * diagonal_ / len);
+  if (short_by >= 1.0) return false;
+  return segment_crosses(a, a + (1.0 - short_by) * (p - a));
+}
+
 P3 SurfaceBoundary::pseudo_normal(std::int32_t t, TriangleRegion region) const {
   if (is_edge(region)) {
     const std::int32_t e = surface_.triangle_edge(t, edge_slot(region));
@@ -382,6 +421,20 @@ double SurfaceBoundary::control_level(const Box<3>& box) const {
     if (!box_triangle_overlap(box, q[0], q[1], q[2])) return;
     if (near_feature_[t] && options_.feature_level_at_edges && !feature_in_box(t, box)) {
       wanted = wanted_at(false);
+      if (wanted <= level) return;
+    }
+    if (!sample_begin_.empty() && sample_begin_[t + 1] > sample_begin_[t]) {
+      // The thickness level of the samples near the box only.
+      double thick_level = -std::numeric_limits<double>::infinity();
+      const double reach2 = sample_reach_[t] * sample_reach_[t];
+      for (std::int32_t k = sample_begin_[t]; k < sample_begin_[t + 1]; ++k) {
+        if (!(sample_level_[k] > thick_level)) continue;
+        const P3 d = (sample_point_[k].array().max(box.lo.array()).min(box.hi.array())).matrix() - sample_point_[k];
+        if (d.squaredNorm() <= reach2) thick_level = sample_level_[k];
+      }
+      const bool feature = near_feature_[t] && !(options_.feature_level_at_edges && !feature_in_box(t, box));
+      wanted = std::max(std::min(std::max(curvature_level_[t], feature ? feature_level : level), options_.max_level),
+                        std::min(thick_level, options_.thickness_max_level));
       if (wanted <= level) return;
     }
     level = wanted;

@@ -45,6 +45,12 @@ struct SurfaceOptions {
   /// mesh3d sets it (Options3d::thickness_cells, thin_retry_cells): with it, no buffer rule.
   double thickness_cells = 0.0;
   double thickness_max_level = 8.0;  ///< cap of the thickness level (set_thickness_level)
+  /// The thickness level from a grid of rays over each triangle (thickness_samples), each
+  /// applying near its own point, instead of one value per triangle from its centroid and
+  /// vertices: a large triangle facing a sheet that comes near it at one place only (rotor.off's
+  /// outer wall, a 27-degree chord of its cylinder over the inner one: 0.0034 thick where the
+  /// four rays see 0.0081) gets the finer level there and nowhere else.
+  bool thickness_sampled = false;
 };
 
 class SurfaceBoundary final : public Boundary<3> {
@@ -62,6 +68,12 @@ class SurfaceBoundary final : public Boundary<3> {
   /// Local minima of the distance within max(3 d, d + 5% of the diagonal), d = the nearest.
   std::vector<ClosestPoint<3>> closest_points(const P3& p, int max_count) const override;
   bool segment_crosses(const P3& a, const P3& b) const override;
+  /// segment_crosses(a, end) for a segment ending on the surface at `p`: `end` stops short of p
+  /// by 1e-7 of the segment, and by 1e-9 of the diagonal at least. Stopping short by the share
+  /// alone left a node 1e-5 from a sliver triangle (rotor.off's outer wall, 0.4 long) an end
+  /// 1e-12 from its plane, within orient3d's tolerance: a Degenerate crossing, so its closest
+  /// point was refused and its projection ran back 0.02 through the wall.
+  bool crosses_before(const P3& a, const P3& p) const;
   double control_level(const Box<3>& box) const override;
 
   // ---- the model ----
@@ -85,6 +97,8 @@ class SurfaceBoundary final : public Boundary<3> {
   /// The thickness level's cells across (0 = off) and its cap; computes the thicknesses on
   /// first use (not thread-safe: call before the level field is read).
   void set_thickness_level(double cells, double max_level);
+  /// SurfaceOptions::thickness_sampled (applies from the next set_thickness_level).
+  void set_thickness_sampled(bool on) { options_.thickness_sampled = on; }
   /// thickness(t) of every triangle, computed once.
   const std::vector<double>& thicknesses();
   /// centroid_thickness(t) of every triangle, computed once.
@@ -129,6 +143,12 @@ class SurfaceBoundary final : public Boundary<3> {
   std::vector<double> thickness_;        ///< thickness(t), when computed
   std::vector<double> centroid_thickness_;  ///< centroid_thickness(t), when computed
   std::vector<double> thickness_level_;  ///< -inf where thickness_cells is off or nothing is behind
+  /// With thickness_sampled: per triangle, its samples [sample_begin_[t], sample_begin_[t + 1])
+  /// of sample_point_ / sample_level_, each applying within sample_reach_[t] of its point.
+  std::vector<std::int32_t> sample_begin_;
+  std::vector<P3> sample_point_;
+  std::vector<double> sample_level_;
+  std::vector<double> sample_reach_;
   double root_side_ = 0.0;
   std::vector<bool> near_feature_;
   double diagonal_ = 0.0;

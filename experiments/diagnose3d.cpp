@@ -27,6 +27,11 @@
 // facing projections, level raise, thickness retry); --nosnap: no feature snapping there;
 // --feature-extra L: SurfaceOptions::feature_extra_levels (default 1), the level field's
 // feature level above the global one; --near X Y Z R with --dump: only octants near a point.
+// --sampled: SurfaceOptions::thickness_sampled (the thickness level from a grid of rays per
+// triangle). Environment, first tree: FEBEMESH_DUMP_CELLS=1 with --near lists the leaves there
+// (level, side, kept, dropped as a pinch or an island); FEBEMESH_DUMP_DROPPED=1 lists every leaf
+// the pinch and island rules dropped; FEBEMESH_PROBE="X Y Z" prints a point's local minima of
+// the distance and whether the segments to them enter kept octants or cross the surface.
 
 #include <cmath>
 #include <cstdio>
@@ -188,6 +193,7 @@ constexpr const char* usage =
     "  --outward C           BoundaryOctantOptions::min_outward  --facing C  min_facing\n"
     "  --feature-extra L     the feature level above the global one (default 1)\n"
     "  --feature-at-edges    the feature level at the feature edges only\n"
+    "  --sampled             SurfaceOptions::thickness_sampled (the thickness level from a grid of rays)\n"
     "  --opposing            drop interior octants at nodes with opposing free faces\n"
     "  --thin-share          print the share of the surface thinner than 0.5-2 octants, and stop\n"
     "whole pipeline:\n"
@@ -205,7 +211,7 @@ constexpr const char* usage =
 int option_values(const std::string& a) {
   static const std::vector<std::pair<std::string, int>> known = {
       {"--accept-folds", 0}, {"--all", 0}, {"--feature-at-edges", 0}, {"--norays", 0}, {"--nosnap", 0},
-      {"--opposing", 0}, {"--pipeline", 0}, {"--quality", 0}, {"--single", 0}, {"--snap", 0},
+      {"--opposing", 0}, {"--pipeline", 0}, {"--quality", 0}, {"--sampled", 0}, {"--single", 0}, {"--snap", 0},
       {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--dump", 1},
       {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
@@ -249,8 +255,10 @@ int main(int argc, char** argv) {
   if (argc > 3 && std::string(argv[3]).rfind("--", 0) != 0) so.thickness_cells = std::atof(argv[3]);
   for (int i = 1; i + 1 < argc; ++i)
     if (std::string(argv[i]) == "--feature-extra") so.feature_extra_levels = std::atof(argv[i + 1]);
-  for (int i = 1; i < argc; ++i)
+  for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--feature-at-edges") so.feature_level_at_edges = true;
+    if (std::string(argv[i]) == "--sampled") so.thickness_sampled = true;
+  }
   int dump = 0, only = -1;
   bool near_on = false;
   P3 near_p = P3::Zero();
@@ -355,6 +363,7 @@ int main(int argc, char** argv) {
   const std::vector<Side> sides = classify(tree, s);
   Flags in = interior_flags(sides);
   const std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
+  const Flags before_pinches = in;
   std::size_t np = remove_pinches(tree, in);
   std::size_t n_opposing = 0;
   for (int i = 0; i < argc; ++i)
@@ -366,11 +375,37 @@ int main(int argc, char** argv) {
         np += remove_pinches(tree, in);
       }
   if (n_opposing > 0) std::printf("opposing free faces: %zu octants dropped\n", n_opposing);
+  const Flags before_islands = in;
   const std::size_t ni = keep_largest_components(tree, in, s.n_components());
   std::size_t n_in = 0;
   for (auto f : in) n_in += f;
   std::printf("%s level %d thickness_cells %.2f: %zu leaves, %zu interior (buffer %zu, pinch %zu, islands %zu)\n",
               path.c_str(), level, so.thickness_cells, tree.n_leaves(), n_in, nb, np, ni);
+  if (near_on && std::getenv("FEBEMESH_DUMP_CELLS"))
+    for (std::size_t i = 0; i < tree.n_leaves(); ++i) {
+      const Box<3> b = geometry(tree, tree.leaf(i));
+      if ((b.center() - near_p).norm() > near_r) continue;
+      std::printf("  leaf %zu level %d lo (%.4f %.4f %.4f) side %d in %d (pinch %d island %d)\n", i, int(tree.leaf(i).level), b.lo[0],
+                  b.lo[1], b.lo[2], int(sides[i]), int(in[i]), int(before_pinches[i] && !in[i] && !before_islands[i]),
+                  int(before_islands[i] && !in[i]));
+    }
+  if (const char* probe = std::getenv("FEBEMESH_PROBE")) {
+    P3 q;
+    std::sscanf(probe, "%lf %lf %lf", &q[0], &q[1], &q[2]);
+    std::printf("PROBE (%.5f %.5f %.5f) inside %d\n", q[0], q[1], q[2], int(s.is_inside(q)));
+    for (const ClosestPoint<3>& c : s.closest_points(q, 4))
+      std::printf("  candidate (%.5f %.5f %.5f) tri %d distance %.6f enters kept %d crosses %d (stopping 1e-7 short: %d)\n",
+                  c.point[0], c.point[1], c.point[2], c.where.patch, c.distance,
+                  int(segment_enters_kept(tree, in, q, P3(c.point), 0.05)), int(s.crosses_before(q, P3(c.point))),
+                  int(s.segment_crosses(q, q + (1.0 - 1e-7) * (P3(c.point) - q))));
+  }
+  if (std::getenv("FEBEMESH_DUMP_DROPPED"))
+    for (std::size_t i = 0; i < tree.n_leaves(); ++i) {
+      const bool pinch = before_pinches[i] && !in[i] && !before_islands[i], island = before_islands[i] && !in[i];
+      if (!pinch && !island) continue;
+      const P3 c = geometry(tree, tree.leaf(i)).center();
+      std::printf("DROPPED %s level %d at %.5f %.5f %.5f\n", pinch ? "pinch" : "island", int(tree.leaf(i).level), c[0], c[1], c[2]);
+    }
   const OctantComplexResult ocr = build_octant_complex(tree, in, s, bo);
   const OctantComplex& oc = ocr.complex;
   std::printf("free faces %zu, surface nodes %zu, next-normal %zu, ray %zu, blind %zu, unfolded %zu, edge-snapped %zu, pushed off lines %zu\n",
@@ -411,7 +446,7 @@ int main(int argc, char** argv) {
       else if (len > 1.5 * h) w = 2;
       why = std::min(why, w);
       if (print)
-        std::printf("    node %d at (%.4f %.4f %.4f) -> (%.4f %.4f %.4f) tri %d: |d|/h %.2f cos(d,nf) %.2f cos(ns,nf) %.2f\n",
+        std::printf("    node %d at (%.7f %.7f %.7f) -> (%.7f %.7f %.7f) tri %d: |d|/h %.2f cos(d,nf) %.2f cos(ns,nf) %.2f\n",
                     q, oc.points[q][0], oc.points[q][1], oc.points[q][2], oc.points[p][0], oc.points[p][1],
                     oc.points[p][2], oc.where[p].patch, len / h, cos_d, cos_n);
     }

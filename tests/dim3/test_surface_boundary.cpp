@@ -208,4 +208,32 @@ TEST_CASE("thickness: the thinnest of centroid and vertices along the inward nor
   CHECK(plate.control_level(box(P3(0.9, 0.4, 0.25), P3(0.95, 0.45, 0.32))) == 5.0);
   plate.set_thickness_level(0, 20);
   CHECK(plate.control_level(box(P3(0.9, 0.4, 0.25), P3(0.95, 0.45, 0.32))) < wanted - 1);
+  // Sampled (SurfaceOptions::thickness_sampled): the level of the rays near the box, where the
+  // plate is about 0.22 thick (x 0.6-0.65, the rays from x 0.55-0.7), not of the top triangle's
+  // thinnest end (0.1); at that end the same.
+  plate.set_thickness_sampled(true);
+  plate.set_thickness_level(4, 20);
+  const double near_box = plate.control_level(box(P3(0.6, 0.3, 0.2), P3(0.65, 0.35, 0.25)));
+  const double stretch = std::sqrt(1 + slope * slope);
+  CHECK(near_box < wanted - 1);
+  CHECK(near_box > std::log2(root * 4 / ((h0 + 0.7 * slope) * stretch)));
+  CHECK(near_box < std::log2(root * 4 / ((h0 + 0.55 * slope) * stretch)));
+  CHECK(plate.control_level(box(P3(0.0, 0.4, 0.05), P3(0.02, 0.45, 0.12))) == Approx(wanted).epsilon(0.02));
+}
+
+TEST_CASE("a segment to the closest point on a sliver triangle does not cross the surface", "[surface_boundary]") {
+  // rotor.off's outer wall is triangles 0.4 long and 0.07 wide. A lattice node of a level-8
+  // interior octant lies 1e-5 inside one of them: a segment stopping 1e-7 of its length short
+  // of the closest point ends 1e-12 from the plane, within orient3d's tolerance (a Degenerate
+  // crossing); crosses_before stops 1e-9 of the diagonal short.
+  const SurfaceBoundary& rotor = data("rotor.off");
+  const P3 q(-0.0246094, -0.2912109, -0.3322266);
+  REQUIRE(rotor.is_inside(q));
+  const ClosestPoint<3> c = rotor.closest_point(q);
+  REQUIRE(c.distance < 2e-5);
+  const P3 p(c.point);
+  CHECK(rotor.segment_crosses(q, q + (1.0 - 1e-7) * (p - q)));
+  CHECK_FALSE(rotor.crosses_before(q, p));
+  CHECK(rotor.crosses_before(q, q + 3.0 * (p - q)));  // one that leaves the solid still crosses
+  CHECK_FALSE(rotor.crosses_before(q, q));
 }
