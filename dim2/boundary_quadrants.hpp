@@ -61,9 +61,10 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges = n
 
 /// Drop interior quadrants nearer to the curve than `fraction` of their size (the buffer rule
 /// against very thin boundary quadrants). Returns how many. `edges`, when given, receives
-/// free_facets(t, in) for the new `in`. `keys` as for remove_pinches.
+/// free_facets(t, in) for the new `in`. `keys` as for remove_pinches. The distances on
+/// n_threads threads (curve queries only read it); the same result for every count.
 std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
-                         FreeEdges* edges = nullptr, const LeafKeys<2>* keys = nullptr);
+                         FreeEdges* edges = nullptr, const LeafKeys<2>* keys = nullptr, int n_threads = 1);
 
 struct BoundaryQuadrantOptions {
   int max_normals = 4;               ///< local minima tried before walking along the curve

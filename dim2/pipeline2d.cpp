@@ -95,7 +95,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     {
       const LeafKeys<2> keys(tree);  // one for both (a key a leaf: its pages were 47% of the
                                      // faults of a glyph run at 8.7 M triangles, built twice)
-      r.n_buffer_dropped = apply_buffer(tree, in, curve, opt.buffer, &edges, &keys);
+      r.n_buffer_dropped = apply_buffer(tree, in, curve, opt.buffer, &edges, &keys, opt.n_threads);
       r.n_pinches_dropped = remove_pinches(tree, in, &edges, &keys);
     }
     clock.lap(attempt == 0 ? "classify" : "classify (repair " + std::to_string(attempt) + ")");
