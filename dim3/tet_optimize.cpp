@@ -166,7 +166,7 @@ struct Optimizer {
   /// call's lists go in a block of their own, of their exact size: one array grown by resize
   /// held up to twice its entries, and old and new at once while it grew (sphere966 L6: 13.9
   /// MB for 4.7 MB of lists, at the pipeline's heap peak, heaptrack).
-  std::vector<const std::int32_t*> nb_list;
+  std::vector<std::int32_t*> nb_list;
   std::vector<std::int32_t> nb_count;
   std::vector<std::unique_ptr<std::int32_t[]>> nb_blocks;
   std::span<const std::int32_t> neighbours(std::int32_t v) const {
@@ -331,7 +331,7 @@ struct Optimizer {
     return true;
   }
   /// Lists the neighbours (the nodes sharing a tetrahedron, ascending) of the nodes of `visit`
-  /// that have none yet, appended to nbs.
+  /// that have none yet, in a new block (nb_blocks).
   void list_neighbours(const std::vector<std::int32_t>& visit) {
     const std::size_t n = mesh.points.size();
     if (nb_list.empty()) nb_list.assign(n, nullptr), nb_count.assign(n, 0);
@@ -371,9 +371,9 @@ struct Optimizer {
     ranges([&](std::vector<std::int32_t>& marks, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::int32_t v = todo[i];
-        std::int32_t* out = const_cast<std::int32_t*>(nb_list[v]);  // this call's own block
+        std::int32_t* out = nb_list[v];
         for_distinct(marks, v, [&](std::int32_t u) { *out++ = u; });
-        sort_short(const_cast<std::int32_t*>(nb_list[v]), out);
+        sort_short(nb_list[v], out);
       }
     });
   }
