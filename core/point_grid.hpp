@@ -1,6 +1,7 @@
 #pragma once
 // A uniform grid over a subset of the points (bucketed by counting sort), for box queries of
-// about the size of the local spacing: the 2D validator asks one per edge of the mesh. The
+// about the size of the local spacing (the cells sized by the points' crowding, not the box's
+// measure alone): the 2D validator asks one per edge of the mesh. The
 // k-d tree it replaced there visited far more nodes than it reported, because the lattice
 // nodes share coordinates with its split values (flange level 9, 3.4e5 triangles: 1.4e9
 // instructions for the edge and duplicate queries and the build).
@@ -17,7 +18,8 @@ namespace febemesh {
 
 template <int Dim> class PointGrid {
  public:
-  /// Buckets pts[id] for id in ids (any order) into about ids.size() square cells.
+  /// Buckets pts[id] for id in ids (any order) into square cells, about one point to each cell
+  /// that holds any.
   PointGrid(const std::vector<Point<Dim>>& pts, const std::vector<std::int32_t>& ids) : pts_(pts) {
     Box<Dim> b = Box<Dim>::empty();
     for (const std::int32_t id : ids)
@@ -25,22 +27,43 @@ template <int Dim> class PointGrid {
     lo_ = b.lo;
     const Point<Dim> ext = b.hi - b.lo;
     const double big = ext.allFinite() ? ext.maxCoeff() : 0.0;
-    std::size_t n_cells = 1;
     for (int d = 0; d < Dim; ++d) k_[d] = 1, inv_[d] = 0.0;
+    std::size_t n_cells = 1;
+    const auto count = [&] {
+      start_.assign(n_cells + 1, 0);
+      for (const std::int32_t id : ids) ++start_[cell_of(pts[id]) + 1];
+    };
     if (big > 0 && !ids.empty()) {
-      // Square cells, about one point each: side s from the box's measure (each extent at least
-      // 1e-3 of the largest, so a flat box does not make needle cells).
+      // Square cells, about one point each over the box first: side s from the box's measure
+      // (each extent at least 1e-3 of the largest, so a flat box does not make needle cells).
       double measure = 1.0;
       for (int d = 0; d < Dim; ++d) measure *= std::max(ext[d], 1e-3 * big);
       const double s = std::pow(measure / static_cast<double>(ids.size()), 1.0 / Dim);
-      for (int d = 0; d < Dim; ++d) {
-        k_[d] = static_cast<int>(std::clamp(std::ceil(ext[d] / s), 1.0, 1e6));
-        inv_[d] = static_cast<double>(k_[d]) / std::max(ext[d], 1e-300);
-        n_cells *= static_cast<std::size_t>(k_[d]);
+      const auto size_cells = [&](double side) {
+        n_cells = 1;
+        for (int d = 0; d < Dim; ++d) {
+          k_[d] = static_cast<int>(std::clamp(std::ceil(ext[d] / side), 1.0, 1e6));
+          inv_[d] = static_cast<double>(k_[d]) / std::max(ext[d], 1e-300);
+          n_cells *= static_cast<std::size_t>(k_[d]);
+        }
+      };
+      size_cells(s);
+      count();
+      // Points on a shell or a thin region of the box crowd the few cells they occupy (the 3D
+      // pipeline's check of the tetrahedra at the surface: ~8 points a held cell, most of them
+      // tested by every query): smaller cells then, by the mean crowding, at most 8 cells a
+      // point in all.
+      std::size_t held = 0;
+      for (std::size_t c = 0; c < n_cells; ++c) held += start_[c + 1] != 0;
+      const double crowding = static_cast<double>(ids.size()) / static_cast<double>(std::max<std::size_t>(held, 1));
+      if (crowding > 2.0) {
+        const double finer = std::min(std::pow(crowding, 1.0 / Dim), std::pow(8.0, 1.0 / Dim));
+        size_cells(s / finer);
+        count();
       }
+    } else {
+      count();
     }
-    start_.assign(n_cells + 1, 0);
-    for (const std::int32_t id : ids) ++start_[cell_of(pts[id]) + 1];
     for (std::size_t c = 0; c < n_cells; ++c) start_[c + 1] += start_[c];
     ids_.resize(ids.size());
     std::vector<std::int32_t> fill(start_.begin(), start_.end() - 1);

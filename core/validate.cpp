@@ -685,10 +685,14 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         return hit;
       });
       for (std::size_t i = 0; i < first_uses.size(); ++i)
-        if (facet_hit[i])
-          on_interior(i, [&](std::int32_t c) {
+        if (facet_hit[i]) {
+          // In node order, whatever the grid's cells (PointGrid sizes them by the points).
+          hits.clear();
+          on_interior(i, [&](std::int32_t c) { hits.push_back(c); });
+          std::sort(hits.begin(), hits.end());
+          for (const std::int32_t c : hits)
             report(c, "facet " + fmt_key(key_of(facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local))));
-          });
+        }
     }
   }
 

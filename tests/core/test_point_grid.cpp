@@ -13,7 +13,7 @@ namespace {
 /// Random points, half of them on a coarse lattice (shared coordinates, as mesh nodes have),
 /// some duplicated, queried with random boxes of every size; the grid must visit exactly the
 /// points inside each box, once each.
-template <int Dim> void check_against_brute_force(std::uint64_t seed, bool flat) {
+template <int Dim> void check_against_brute_force(std::uint64_t seed, bool flat, bool shell = false) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 2.0);
   const std::size_t n = 1 + rng() % 400;
@@ -21,6 +21,9 @@ template <int Dim> void check_against_brute_force(std::uint64_t seed, bool flat)
   for (auto& p : pts) {
     for (int d = 0; d < Dim; ++d) p[d] = rng() % 2 ? u(rng) : std::floor(u(rng) * 8) / 8;
     if (flat) p[Dim - 1] = 0.5;
+    // On a sphere (a circle in 2D): the points crowd few of the box's cells, and the grid
+    // makes its cells smaller.
+    if (shell && p.norm() > 0) p = Point<Dim>(p / p.norm());
   }
   for (std::size_t i = 0; i < n / 10; ++i) pts[rng() % n] = pts[rng() % n];
   std::vector<std::int32_t> ids;
@@ -46,6 +49,7 @@ template <int Dim> void check_against_brute_force(std::uint64_t seed, bool flat)
 
 TEMPLATE_TEST_CASE_SIG("PointGrid visits exactly the points in a box", "[point_grid]", ((int Dim), Dim), 2, 3) {
   for (std::uint64_t seed = 1; seed <= 100; ++seed) check_against_brute_force<Dim>(seed, seed % 4 == 0);
+  for (std::uint64_t seed = 101; seed <= 150; ++seed) check_against_brute_force<Dim>(seed, false, true);
 }
 
 TEST_CASE("PointGrid: no points, one point, non-finite coordinates", "[point_grid]") {
