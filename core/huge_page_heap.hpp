@@ -1,5 +1,5 @@
 #pragma once
-// glibc's malloc on transparent huge pages, for the whole process (issue 8).
+// glibc's malloc on transparent huge pages, one arena, for the whole process (issue 8).
 
 #include <optional>
 #include <string>
@@ -8,7 +8,8 @@ namespace febemesh {
 
 /// The GLIBC_TUNABLES value that adds glibc.malloc.hugetlb=1 (malloc advises transparent huge
 /// pages on the memory it takes from the kernel, heap and mapped blocks alike) to `current`
-/// (the variable's value, null when unset); nullopt when `current` sets that tunable already,
+/// (the variable's value, null when unset), and glibc.malloc.arena_max=1 (one arena for all
+/// threads) unless `current` sets an arena count; nullopt when `current` sets hugetlb already,
 /// to whatever value.
 std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 
