@@ -240,7 +240,8 @@ std::vector<std::uint8_t> fixed_nodes(const OctantComplex& oc, const TetMesh& fe
 
 /// Frees all of the complex but its snap marks (OctantComplex::snapped): its lattice, points,
 /// surface locations, projections and boundary octants, which the tetrahedra copied. Held
-/// beside the smoothing's lists they were 20 MB of sphere966 level 6's heap peak.
+/// beside the smoothing's lists they were at its peak (bench_mesh3d sphere966 level 6, one
+/// thread: 151-152 MB with them, 134-135 MB without).
 void keep_snap_marks_only(OctantComplex& c) {
   c.lattice = {};
   std::vector<P3>().swap(c.points);
