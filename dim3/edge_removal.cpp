@@ -6,12 +6,13 @@
 #include <iterator>
 #include <limits>
 #include <queue>
-#include <unordered_map>
+#include <optional>
 #include <utility>
 
 #include "core/error.hpp"
 #include "core/incidence_csr.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/point_grid.hpp"
 #include "dim3/tet_optimize.hpp"
 
 namespace febemesh::dim3 {
@@ -175,37 +176,30 @@ struct Work {
     return l;
   }
 
-  /// The interface nodes by cell of a uniform grid whose cells are the longest interface edge at
-  /// the time it is built (on the first concave swap that gets that far); the nodes do not move
-  /// here and no new ones come, so it stays right. longest_edge follows the faces added since.
-  double longest_edge = 0.0, grid_cell = 0.0;
-  std::unordered_map<std::uint64_t, std::vector<std::int32_t>> grid;
-  std::uint64_t grid_key(std::int64_t i, std::int64_t j, std::int64_t k) const {
-    const auto b = [](std::int64_t x) { return static_cast<std::uint64_t>(x + (1 << 20)) & 0x1fffff; };
-    return b(i) << 42 | b(j) << 21 | b(k);
-  }
-  std::int64_t grid_index(double x) const { return static_cast<std::int64_t>(std::floor(x / grid_cell)); }
-  void build_grid() {
-    grid_cell = longest_edge;
-    for (std::size_t v = 0; v < node_faces.size(); ++v) {
-      if (node_faces[v].empty()) continue;
-      const P3& x = mesh.points[v];
-      grid[grid_key(grid_index(x[0]), grid_index(x[1]), grid_index(x[2]))].push_back(static_cast<std::int32_t>(v));
-    }
-  }
+  /// The interface nodes in a point grid (core/point_grid.hpp), built on the first concave swap
+  /// that gets that far: the nodes do not move here and no new ones come, so it stays right.
+  /// longest_edge (of the live interface triangles) follows the faces added since.
+  double longest_edge = 0.0;
+  std::optional<PointGrid<3>> grid;
   /// Whether no live interface triangle but `skip`'s two reaches into the closed tetrahedron
   /// a b back front, which a concave surface swap adds to the solid: none has a node in it, an
   /// edge through its new faces a-front-back and b-front-back, or is crossed by its new edge
   /// front-back (its other faces and edges are the old surface's). Any such triangle has its
   /// nodes within the longest interface edge of the tetrahedron's box. Touching counts.
   bool clear_outside(std::int32_t a, std::int32_t b, std::int32_t front, std::int32_t back, const std::vector<std::int32_t>& skip) {
-    if (grid.empty()) build_grid();
+    if (!grid) {
+      std::vector<std::int32_t> interface_nodes;
+      for (std::size_t v = 0; v < node_faces.size(); ++v)
+        if (!node_faces[v].empty()) interface_nodes.push_back(static_cast<std::int32_t>(v));
+      grid.emplace(mesh.points, interface_nodes);
+    }
     const P3* p = mesh.points.data();
     const std::array<std::int32_t, 4> tet = {a, b, back, front};  // positive
     P3 lo = p[a], hi = p[a];
     for (const std::int32_t v : tet) lo = lo.cwiseMin(p[v]), hi = hi.cwiseMax(p[v]);
-    lo.array() -= longest_edge;
-    hi.array() += longest_edge;
+    // (A hair more: a node exactly one edge away stays in the box whatever the rounding.)
+    lo.array() -= longest_edge * (1.0 + 1e-9);
+    hi.array() += longest_edge * (1.0 + 1e-9);
     const auto in_tet = [&](std::int32_t x) {
       return orient(p[a], p[b], p[back], p[x]) >= 0 && orient(p[a], p[front], p[b], p[x]) >= 0 &&
              orient(p[a], p[back], p[front], p[x]) >= 0 && orient(p[b], p[front], p[back], p[x]) >= 0;
@@ -220,25 +214,22 @@ struct Work {
     const auto shares = [](std::int32_t x, std::int32_t y, std::int32_t u, std::int32_t v, std::int32_t w) {
       return x == u || x == v || x == w || y == u || y == v || y == w;
     };
-    for (std::int64_t i = grid_index(lo[0]); i <= grid_index(hi[0]); ++i)
-      for (std::int64_t j = grid_index(lo[1]); j <= grid_index(hi[1]); ++j)
-        for (std::int64_t k = grid_index(lo[2]); k <= grid_index(hi[2]); ++k) {
-          const auto it = grid.find(grid_key(i, j, k));
-          if (it == grid.end()) continue;
-          for (const std::int32_t x : it->second)
-            for (const std::int32_t f : node_faces[x]) {
-              if (std::find(skip.begin(), skip.end(), f) != skip.end()) continue;  // (a triangle is seen up to 3 times)
-              const Tri& t = faces[f];
-              for (int e = 0; e < 3; ++e) {
-                const std::int32_t u = t[e], v = t[(e + 1) % 3];
-                if (std::find(tet.begin(), tet.end(), u) == tet.end() && in_tet(u)) return false;
-                for (const std::int32_t c : {a, b})
-                  if (!shares(u, v, c, front, back) && meets(u, v, c, front, back)) return false;
-              }
-              if (!shares(front, back, t[0], t[1], t[2]) && meets(front, back, t[0], t[1], t[2])) return false;
-            }
+    bool clear = true;
+    grid->query(Box<3>{lo, hi}, [&](std::int32_t x) {
+      for (const std::int32_t f : node_faces[x]) {
+        if (!clear) return;
+        if (std::find(skip.begin(), skip.end(), f) != skip.end()) continue;  // (a triangle is seen up to 3 times)
+        const Tri& t = faces[f];
+        for (int e = 0; e < 3 && clear; ++e) {
+          const std::int32_t u = t[e], v = t[(e + 1) % 3];
+          if (std::find(tet.begin(), tet.end(), u) == tet.end() && in_tet(u)) clear = false;
+          for (const std::int32_t c : {a, b})
+            if (!shares(u, v, c, front, back) && meets(u, v, c, front, back)) clear = false;
         }
-    return true;
+        if (!shares(front, back, t[0], t[1], t[2]) && meets(front, back, t[0], t[1], t[2])) clear = false;
+      }
+    });
+    return clear;
   }
 
   /// Contracts edge uv into v (node u goes) if that raises the worst angle of u's tetrahedra
@@ -464,7 +455,7 @@ struct Work {
 
 EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
                                   const EdgeRemovalOptions& opt) {
-  Work w{mesh, where, opt, 0, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0, {}};
+  Work w{mesh, where, opt, 0, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}};
   const std::size_t n = mesh.points.size();
   w.n_input = static_cast<std::int32_t>(mesh.solid.size());
   for (std::size_t e = 0; e < mesh.solid.size(); ++e)
