@@ -165,10 +165,11 @@ double facet_size(const Facet& f, const std::vector<Point<3>>& pts) {
   return h;
 }
 
-/// on_facet_interior for one triangle and many points: the triangle's normal once, and for
-/// each point the distance to its plane first (most points tested are off the plane, and then
-/// no barycentric coordinates are needed). The same numbers as barycentric(), so the same
-/// answers (the facet check was a third of the 3D validation: sphere966 level 6, 0.35 s of 1.1).
+/// Is a point on the interior of a triangle facet (within rel * h of its plane, h its size,
+/// strictly inside its edges)? The normal once, and for each point the distance to the plane
+/// first (most points tested are off the plane, and then no barycentric coordinates are
+/// needed); the same numbers as barycentric() (the facet check was a third of the 3D
+/// validation: sphere966 level 6, 0.35 s of 1.1).
 class TriangleInterior {
  public:
   TriangleInterior(const Point<3>& a, const Point<3>& b, const Point<3>& c, double h, double rel)
@@ -188,16 +189,13 @@ class TriangleInterior {
   bool none_;  ///< a degenerate triangle (or facet size 0): no interior
 };
 
-/// Is p on the interior of the facet (within rel * size of its plane, strictly inside its edges)?
-/// h is facet_size(f, pts), computed once per facet by the caller.
-bool on_facet_interior(const Point<3>& p, const Facet& f, double h, const std::vector<Point<3>>& pts, double rel) {
+/// Is p on the interior of the quad facet f (within rel * size of its plane, strictly inside
+/// its edges)? h is facet_size(f, pts), computed once per facet by the caller. Triangle facets:
+/// TriangleInterior.
+bool on_quad_interior(const Point<3>& p, const Facet& f, double h, const std::vector<Point<3>>& pts, double rel) {
   if (h == 0.0) return false;
+  // As triangles (0,1,2) and (0,2,3): the diagonal 0-2 belongs to the interior.
   const auto& a = pts[f.node[0].v];
-  if (f.n == 3) {
-    const auto [l, dist] = barycentric(p, a, pts[f.node[1].v], pts[f.node[2].v]);
-    return dist <= rel * h && l.minCoeff() > rel;
-  }
-  // Quad as triangles (0,1,2) and (0,2,3): the diagonal 0-2 belongs to the interior.
   const auto& c = pts[f.node[2].v];
   const auto [l1, d1] = barycentric(p, a, pts[f.node[1].v], c);
   if (d1 <= rel * h && l1[0] > rel && l1[2] > rel && l1[1] >= -rel) return true;
@@ -676,7 +674,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
         grid.query(box, [&](std::int32_t c) {
           for (int k = 0; k < f.n; ++k)
             if (f.node[k].v == c) return;
-          if (on_facet_interior(pts[c], f, h, pts, rel)) at(c);
+          if (on_quad_interior(pts[c], f, h, pts, rel)) at(c);
         });
       };
       const std::vector<std::uint8_t> facet_hit = marked(first_uses.size(), [&](std::size_t i) {
