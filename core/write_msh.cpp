@@ -138,12 +138,16 @@ class LineBlock {
   void end(const char* p) { size_ = static_cast<std::size_t>(p - buf_.get()); }
   std::string_view text() const { return {buf_.get(), size_}; }
   void clear() { size_ = 0; }
-  RealTexts& reals() { return reals_; }
+  /// The block's number texts (made on first use: only the coordinate lines have numbers).
+  RealTexts& reals() {
+    if (!reals_) reals_ = std::make_unique<RealTexts>();
+    return *reals_;
+  }
 
  private:
   std::unique_ptr<char[]> buf_;
   std::size_t size_ = 0, capacity_ = 0;
-  RealTexts reals_;
+  std::unique_ptr<RealTexts> reals_;
 };
 
 /// Items per block of parallel_lines: ~0.5-1 MiB of text (30-60 bytes a line).
