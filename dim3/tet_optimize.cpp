@@ -714,7 +714,8 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     for (std::size_t v = 0; v < n; ++v)
       if (active[v] && o.movable(static_cast<std::int32_t>(v))) nodes.push_back(static_cast<std::int32_t>(v));
     for (Optimizer::Scratch& sc : scratch) sc.moves = 0;
- o.list_neighbours(nodes);    const OrderedSweep order(nodes, n, opt.n_threads, for_neighbours);
+    o.list_neighbours(nodes);
+    const OrderedSweep order(nodes, n, opt.n_threads, for_neighbours);
     order.run([&](std::int32_t v, int t) {
       if (!stale[v]) return;
       stale[v] = 0;
