@@ -343,6 +343,9 @@ int main(int argc, char** argv) {
         min_dihedral = summarize_quality(r.fe.mesh).min_angle_deg;
         vol_err = measure_fidelity(r.fe.mesh, s, 1).volume_rel_error;
         repairs = r.n_repairs;
+        std::string stages;  // the mesh's own stage times (the last try's, after any retry's)
+        for (const StageTime3& t : r.times) stages += " " + t.name + " " + std::to_string(t.seconds).substr(0, 5);
+        std::printf("STAGES%s\n", stages.c_str());
         if (quality) print_quality_diagnosis(r, s, dump, below);
       } catch (const std::exception& e) {
         verdict = std::string("refused: ") + e.what();
