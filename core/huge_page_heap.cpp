@@ -4,6 +4,9 @@
 #include <cstring>
 #include <fstream>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <sys/auxv.h>
 #include <unistd.h>
 
@@ -13,25 +16,23 @@
 
 namespace febemesh {
 
-std::optional<std::string> tunables_with_huge_page_heap(const char* current) {
-  const std::string now = current ? current : "";
+bool tunable_is_set(const char* tunables, const std::string& name) {
+  const std::string now = tunables ? tunables : "";
   // Entries are name=value, separated by ':'.
-  const auto has = [&](const std::string& tunable) {
-    for (std::size_t begin = 0; begin <= now.size();) {
-      std::size_t end = now.find(':', begin);
-      if (end == std::string::npos) end = now.size();
-      if (now.compare(begin, tunable.size() + 1, tunable + "=") == 0) return true;
-      begin = end + 1;
-    }
-    return false;
-  };
-  if (has("glibc.malloc.hugetlb")) return std::nullopt;
-  std::string out = now;
+  for (std::size_t begin = 0; begin <= now.size();) {
+    std::size_t end = now.find(':', begin);
+    if (end == std::string::npos) end = now.size();
+    if (now.compare(begin, name.size() + 1, name + "=") == 0) return true;
+    begin = end + 1;
+  }
+  return false;
+}
+
+std::optional<std::string> tunables_with_huge_page_heap(const char* current) {
+  if (tunable_is_set(current, "glibc.malloc.hugetlb")) return std::nullopt;
+  std::string out = current ? current : "";
   const auto add = [&](const std::string& entry) { out += (out.empty() ? "" : ":") + entry; };
-  // One arena for every thread: with an arena a thread, the second thread's blocks did not
-  // reuse what the first had freed (bench_mesh3d sphere966 L6 on two threads: peak 154 -> 142-144
-  // MB, 104 -> 96-98 B/tet, the same wall and CPU time; flange 1e6: 496-498 -> 495 MB).
-  if (!has("glibc.malloc.arena_max")) add("glibc.malloc.arena_max=1");
+  if (!tunable_is_set(current, "glibc.malloc.arena_max")) add("glibc.malloc.arena_max=1");
   add("glibc.malloc.hugetlb=1");
   return out;
 }
@@ -67,8 +68,6 @@ bool under_valgrind() {
 
 void reexec_with_huge_page_heap(char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
-  const char* opt_out = std::getenv("FEBEMESH_HUGE_PAGES");
-  if (opt_out && std::strcmp(opt_out, "0") == 0) return;
   const char* before = std::getenv("GLIBC_TUNABLES");
   const std::optional<std::string> tunables = tunables_with_huge_page_heap(before);
   if (!tunables || under_valgrind() || started_by_loader() || !kernel_has_huge_pages()) return;
@@ -78,6 +77,16 @@ void reexec_with_huge_page_heap(char** argv) {
   // Still here: the exec failed; run on as started (children would inherit the tunable).
   if (saved) setenv("GLIBC_TUNABLES", saved->c_str(), 1);
   else unsetenv("GLIBC_TUNABLES");
+#else
+  (void)argv;
+#endif
+}
+
+void set_up_heap(char** argv) {
+#if defined(__GLIBC__) && defined(__linux__)
+  const char* huge = std::getenv("FEBEMESH_HUGE_PAGES");
+  if (huge && std::strcmp(huge, "1") == 0) reexec_with_huge_page_heap(argv);
+  if (!tunable_is_set(std::getenv("GLIBC_TUNABLES"), "glibc.malloc.arena_max")) mallopt(M_ARENA_MAX, 1);
 #else
   (void)argv;
 #endif

@@ -1,10 +1,13 @@
 #pragma once
-// glibc's malloc on transparent huge pages, one arena, for the whole process (issue 8).
+// The process's malloc: one arena, and transparent huge pages on request (issue 8).
 
 #include <optional>
 #include <string>
 
 namespace febemesh {
+
+/// Whether the GLIBC_TUNABLES value `tunables` (null when unset) sets `name`, to any value.
+bool tunable_is_set(const char* tunables, const std::string& name);
 
 /// The GLIBC_TUNABLES value that adds glibc.malloc.hugetlb=1 (malloc advises transparent huge
 /// pages on the memory it takes from the kernel, heap and mapped blocks alike) to `current`
@@ -15,15 +18,25 @@ std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 
 /// Runs the program again, in the same process (/proc/self/exe, the same arguments), with
 /// tunables_with_huge_page_heap in its environment, and returns only when it does not: the
-/// tunable is set already (this is the second start), FEBEMESH_HUGE_PAGES=0, the kernel has
-/// transparent huge pages off, the C library is not glibc, the process runs under valgrind or
-/// was started through the dynamic loader (ld.so PROGRAM), or the exec fails. Call it first
-/// thing in main.
-///
-/// Why: the 2D pipeline's arrays under 32 MiB live in malloc's heap (dim2/heap_policy), which
-/// glibc grows by 4 KiB pages; on this VM a 4 KiB fault costs ~11 us (3 s a GiB touched against
-/// 0.06 s with 2 MiB pages, measured), and they were most of the system time of a run.
-/// GLIBC_TUNABLES is read only when the C library starts, so it cannot be set from inside.
+/// tunable is set already (this is the second start), the kernel has transparent huge pages
+/// off, the C library is not glibc, the process runs under valgrind or was started through the
+/// dynamic loader (ld.so PROGRAM), or the exec fails.
 void reexec_with_huge_page_heap(char** argv);
+
+/// The process's malloc set-up; call it first thing in main. On glibc: one arena for every
+/// thread (mallopt, unless GLIBC_TUNABLES sets an arena count), and with FEBEMESH_HUGE_PAGES=1
+/// the restart of reexec_with_huge_page_heap.
+///
+/// One arena: with an arena a thread, the second thread's blocks did not reuse what the first
+/// had freed (bench_mesh3d sphere966 L6 on two threads: peak 154 -> 142-144 MB, the same time).
+/// Huge pages only on request: on the Firecracker VM of sessions 22-23 a 4 KiB page's first
+/// touch cost ~11 us and the huge-page heap saved 7-8% of the 10^6-element benchmarks; on the
+/// VM of session 25 (free page reporting of 8 MiB blocks to the host, THP defrag on madvise) it
+/// did not pay, in interleaved pairs, one thread: bench_mesh3d sphere966 L6 slower with it in 7
+/// of 7 (4.05-5.43 s wall, system 0.21-1.18 s, against 3.85-4.10 s, 0.05-0.08 s), bench_mesh2d
+/// flange 1e6 in 5 of 7 (4.04-7.95 s against 3.57-5.32 s), the CLI on sphere966 L6 (which
+/// also validates and writes mesh.vtu) in 3 of 7 (5.64-7.34 s against 5.88-6.82 s). The
+/// arrays that reserve_huge advises keep their advice.
+void set_up_heap(char** argv);
 
 }  // namespace febemesh

@@ -67,7 +67,7 @@ Fit calibrate(const dim2::CurveBoundary& base) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  febemesh::reexec_with_huge_page_heap(argv);  // first: it may start the program again
+  febemesh::set_up_heap(argv);  // first: it may start the program again
   std::vector<double> sizes{1e4, 1e5, 1e6};
   const std::string data = FEBEMESH_DATA_DIR, src = FEBEMESH_SOURCE_DIR;
   std::vector<std::string> inputs{src + "/examples/flange.json", src + "/examples/bracket.json",

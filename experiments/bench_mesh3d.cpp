@@ -48,7 +48,7 @@ std::vector<std::string> split(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  febemesh::reexec_with_huge_page_heap(argv);  // first: it may start the program again
+  febemesh::set_up_heap(argv);  // first: it may start the program again
   std::vector<int> levels{3, 4, 5};
   const std::string data = FEBEMESH_DATA_DIR, src = FEBEMESH_SOURCE_DIR;
   std::vector<std::string> inputs{data + "/3d/sphere966.off"};

@@ -21,3 +21,14 @@ TEST_CASE("the huge-page tunable is added to GLIBC_TUNABLES, once", "[huge_pages
   CHECK(tunables_with_huge_page_heap("glibc.malloc.hugetlbx=1") == "glibc.malloc.hugetlbx=1:" + both);
   CHECK(tunables_with_huge_page_heap("glibc.malloc.arena_maxx=2") == "glibc.malloc.arena_maxx=2:" + both);
 }
+
+TEST_CASE("a tunable is set when its name starts an entry of GLIBC_TUNABLES", "[huge_pages]") {
+  CHECK_FALSE(tunable_is_set(nullptr, "glibc.malloc.arena_max"));
+  CHECK_FALSE(tunable_is_set("", "glibc.malloc.arena_max"));
+  CHECK(tunable_is_set("glibc.malloc.arena_max=4", "glibc.malloc.arena_max"));
+  CHECK(tunable_is_set("glibc.malloc.check=3:glibc.malloc.arena_max=2", "glibc.malloc.arena_max"));
+  CHECK_FALSE(tunable_is_set("glibc.malloc.arena_maxx=2", "glibc.malloc.arena_max"));
+  CHECK_FALSE(tunable_is_set("xglibc.malloc.arena_max=2", "glibc.malloc.arena_max"));
+  CHECK_FALSE(tunable_is_set("glibc.malloc.arena_max", "glibc.malloc.arena_max"));  // no value: not an entry
+}
+
