@@ -20,7 +20,8 @@ std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 /// tunables_with_huge_page_heap in its environment, and returns only when it does not: the
 /// tunable is set already (this is the second start), the kernel has transparent huge pages
 /// off, the C library is not glibc, the process runs under valgrind or was started through the
-/// dynamic loader (ld.so PROGRAM), or the exec fails.
+/// dynamic loader (ld.so PROGRAM), or the exec fails. A restart because glibc reads
+/// GLIBC_TUNABLES only when it starts, and mallopt has no huge-page setting.
 void reexec_with_huge_page_heap(char** argv);
 
 /// The process's malloc set-up; call it first thing in main. On glibc: one arena for every
