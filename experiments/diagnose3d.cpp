@@ -35,8 +35,8 @@
 // FEBEMESH_FOLD_STATS=1 (rotor.off only: its axis is x) tallies the boundary octants, folded and
 // not, by region (plate, wall, blades), by whether their nodes' projections land on opposite
 // sheets ("split") and by how the face meets the surface; in the wall also by the local thickness
-// in octants; FEBEMESH_FOLD_WHERE=1 lists the folded wall octants. --flat-buffer B and
-// --max-level L set Options3d::flat_buffer and max_level.
+// in octants; FEBEMESH_FOLD_WHERE=1 lists the folded wall octants. --flat-buffer B, --max-level L
+// and --worse-repairs N set Options3d::flat_buffer, max_level and worse_repairs.
 
 #include <cmath>
 #include <cstdio>
@@ -207,7 +207,7 @@ constexpr const char* usage =
     "                        --dump N prints the N worst: nodes, edges (length, angle), interface\n"
     "                        faces and each node's worst angles\n"
     "  --single              one try, no fallbacks           --nosnap  no feature snapping\n"
-    "  --accept-folds --peel-rounds N --buffer B --flat-buffer B --max-level L --max-repairs N --island-refinements N\n"
+    "  --accept-folds --peel-rounds N --buffer B --flat-buffer B --max-level L --worse-repairs N --max-repairs N --island-refinements N\n"
     "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N\n"
     "  --extra-levels N --thickness-extra N --optimize-sweeps N --target-dihedral DEG --smooth N\n"
     "                        the Options3d fields of those names (dim3/pipeline3d.hpp)\n";
@@ -217,7 +217,7 @@ int option_values(const std::string& a) {
   static const std::vector<std::pair<std::string, int>> known = {
       {"--accept-folds", 0}, {"--all", 0}, {"--feature-at-edges", 0}, {"--norays", 0}, {"--nosnap", 0},
       {"--opposing", 0}, {"--pipeline", 0}, {"--quality", 0}, {"--sampled", 0}, {"--single", 0}, {"--snap", 0},
-      {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--flat-buffer", 1}, {"--max-level", 1}, {"--dump", 1},
+      {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--flat-buffer", 1}, {"--max-level", 1}, {"--worse-repairs", 1}, {"--dump", 1},
       {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
@@ -302,6 +302,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--buffer") opt.buffer = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--flat-buffer") opt.flat_buffer = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--max-level") opt.max_level = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--worse-repairs") opt.worse_repairs = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--max-repairs") opt.max_repairs = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--island-refinements") opt.island_refinements = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--island-cells") opt.island_cells = std::atof(argv[i + 1]);
