@@ -257,7 +257,8 @@ std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep)
   return removed;
 }
 
-std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads) {
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads,
+                         bool whole_face) {
   if (fraction <= 0) return 0;
   std::size_t removed = 0;
   for (int pass = 0; pass < 4; ++pass) {
@@ -269,13 +270,14 @@ std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary&
         const auto c = f.corners();
         const double h = face_size(t, f.cell);
         P3 centre = P3::Zero();
-        double d = std::numeric_limits<double>::infinity();
+        double d = whole_face ? 0.0 : std::numeric_limits<double>::infinity();
+        const auto take = [&](double x) { d = whole_face ? std::max(d, x) : std::min(d, x); };
         for (const LP& p : c) {
           const P3 x = position(t, p);
           centre += 0.25 * x;
-          d = std::min(d, s.closest_point(x).distance);
+          take(s.closest_point(x).distance);
         }
-        d = std::min(d, s.closest_point(centre).distance);
+        take(s.closest_point(centre).distance);
         near[k] = d < fraction * h ? 1 : 0;
       }
     });

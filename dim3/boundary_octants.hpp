@@ -110,7 +110,10 @@ std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep)
 
 /// Drop interior octants whose free faces come nearer the surface than `fraction` of their size.
 /// The facets' distances on n_threads threads (the same octants dropped for any count).
-std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads = 1);
+/// With `whole_face`, only those whose free face lies that near the surface at all its corners
+/// and its centre (a face flat on the surface; see Options3d::flat_buffer).
+std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads = 1,
+                         bool whole_face = false);
 
 struct BoundaryOctantOptions {
   int max_normals = 4;               ///< local minima tried per node

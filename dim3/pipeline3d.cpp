@@ -765,6 +765,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     const std::vector<Side> sides = classify(tree, s, opt.n_threads);
     Flags in = interior_flags(sides);
     r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer, opt.n_threads);
+    if (opt.flat_buffer > opt.buffer) r.n_buffer_dropped += apply_buffer(tree, in, s, opt.flat_buffer, opt.n_threads, true);
     r.n_peeled = peel(tree, in, peel_points);
     r.n_pinches_dropped = remove_pinches(tree, in);
     r.n_opposing_dropped = 0;

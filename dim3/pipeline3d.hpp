@@ -26,6 +26,14 @@ struct Options3d {
   int extra_levels = 2;              ///< curvature/feature refinement above `level`
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
+  /// Drop interior octants whose free face lies nearer the surface than this x size at all its
+  /// corners and its centre (apply_buffer's whole_face; 0 = off). For the tries without the
+  /// buffer rule: a face flat on the surface (rotor's rim, x 0.22581, lies 0.00022 above a
+  /// lattice plane: 0.05 of a level-8 octant, 0.11 of a level-9 one) makes a flat boundary
+  /// octant, and its neighbours' side faces have corners whose projections run along the face
+  /// (cos 0), into tetrahedra of no volume that the untangling cannot open and that refining
+  /// keeps (the plane is a lattice plane of every finer level).
+  double flat_buffer = 0.0;
   bool snap_features = true;
   /// Drop interior octants at nodes with free faces on both sides along an axis
   /// (remove_opposing), after the pinch rule. Off: measured (CLI, L4, one thread, tets / min

@@ -32,6 +32,11 @@
 // (level, side, kept, dropped as a pinch or an island); FEBEMESH_DUMP_DROPPED=1 lists every leaf
 // the pinch and island rules dropped; FEBEMESH_PROBE="X Y Z" prints a point's local minima of
 // the distance and whether the segments to them enter kept octants or cross the surface.
+// FEBEMESH_FOLD_STATS=1 (rotor.off only: its axis is x) tallies the boundary octants, folded and
+// not, by region (plate, wall, blades), by whether their nodes' projections land on opposite
+// sheets ("split") and by how the face meets the surface; in the wall also by the local thickness
+// in octants; FEBEMESH_FOLD_WHERE=1 lists the folded wall octants. --flat-buffer B, --max-level L
+// and --worse-repairs N set Options3d::flat_buffer, max_level and worse_repairs.
 
 #include <cmath>
 #include <cstdio>
@@ -202,7 +207,7 @@ constexpr const char* usage =
     "                        --dump N prints the N worst: nodes, edges (length, angle), interface\n"
     "                        faces and each node's worst angles\n"
     "  --single              one try, no fallbacks           --nosnap  no feature snapping\n"
-    "  --accept-folds --peel-rounds N --buffer B --max-repairs N --island-refinements N\n"
+    "  --accept-folds --peel-rounds N --buffer B --flat-buffer B --max-level L --worse-repairs N --max-repairs N --island-refinements N\n"
     "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N\n"
     "  --extra-levels N --thickness-extra N --optimize-sweeps N --target-dihedral DEG --smooth N\n"
     "                        the Options3d fields of those names (dim3/pipeline3d.hpp)\n";
@@ -212,7 +217,7 @@ int option_values(const std::string& a) {
   static const std::vector<std::pair<std::string, int>> known = {
       {"--accept-folds", 0}, {"--all", 0}, {"--feature-at-edges", 0}, {"--norays", 0}, {"--nosnap", 0},
       {"--opposing", 0}, {"--pipeline", 0}, {"--quality", 0}, {"--sampled", 0}, {"--single", 0}, {"--snap", 0},
-      {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--dump", 1},
+      {"--thin-share", 0}, {"--unfold", 0}, {"--near", 4}, {"--below", 1}, {"--buffer", 1}, {"--flat-buffer", 1}, {"--max-level", 1}, {"--worse-repairs", 1}, {"--dump", 1},
       {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
@@ -295,6 +300,9 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::string(argv[i]) == "--peel-rounds") opt.peel_rounds = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--buffer") opt.buffer = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--flat-buffer") opt.flat_buffer = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--max-level") opt.max_level = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--worse-repairs") opt.worse_repairs = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--max-repairs") opt.max_repairs = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--island-refinements") opt.island_refinements = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--island-cells") opt.island_cells = std::atof(argv[i + 1]);
@@ -365,7 +373,8 @@ int main(int argc, char** argv) {
   Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
   const std::vector<Side> sides = classify(tree, s);
   Flags in = interior_flags(sides);
-  const std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
+  std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
+  if (opt.flat_buffer > opt.buffer) nb += apply_buffer(tree, in, s, opt.flat_buffer, 1, true);
   const Flags before_pinches = in;
   std::size_t np = remove_pinches(tree, in);
   std::size_t n_opposing = 0;
@@ -483,6 +492,51 @@ int main(int argc, char** argv) {
       }
       ++shown;
     }
+  }
+  if (std::getenv("FEBEMESH_FOLD_STATS")) {
+    // Per folded octant (and all): region on rotor (x axis: plate x < -0.097, wall r 0.40-0.46,
+    // blades r > 0.46), whether its corners' projections land on opposite sheets (two surface
+    // normals with cos < 0), and the face normal's tangency to the surface (max |cos(ns, nf)|).
+    std::map<std::string, std::array<int, 2>> tally;
+    for (std::size_t k = 0; k < oc.boundary.size(); ++k) {
+      const BoundaryOctant& b = oc.boundary[k];
+      const bool bad = bad_octants.count(static_cast<std::int32_t>(k)) > 0;
+      const P3 nf = facet_normal<3>(b.face);
+      const P3 c = geometry(tree, b.cell).center();
+      const double r = std::hypot(c[1], c[2]);
+      const char* region = c[0] < -0.097 ? "plate" : r < 0.40 ? "inner" : r < 0.46 ? "wall" : "blade";
+      double split = 1, tang = 0;
+      std::vector<P3> ns;
+      for (std::int32_t q : b.ring) ns.push_back(s.surface().normal(oc.where[oc.projection[q]].patch).normalized());
+      for (std::size_t i = 0; i < ns.size(); ++i) {
+        tang = std::max(tang, ns[i].dot(nf));
+        for (std::size_t j = i + 1; j < ns.size(); ++j) split = std::min(split, ns[i].dot(ns[j]));
+      }
+      const std::string key = std::string(region) + (split < 0 ? " split" : " one-sheet") +
+                              (tang < 0.5 ? " tangent(<0.5)" : tang < 0.9 ? " oblique" : " facing");
+      ++tally[key][bad ? 1 : 0];
+      if (std::string(region) == "wall") {
+        // Local thickness at the centre: nearest point plus the nearest local minimum on a sheet
+        // facing the other way; cos of the face normal with the radial direction.
+        const auto cps = s.closest_points(c, 4);
+        double th = -1;
+        if (!cps.empty()) {
+          const P3 n0 = s.surface().normal(cps[0].where.patch).normalized();
+          for (std::size_t i = 1; i < cps.size() && th < 0; ++i)
+            if (s.surface().normal(cps[i].where.patch).normalized().dot(n0) < 0) th = cps[0].distance + cps[i].distance;
+        }
+        const P3 radial = P3(0, c[1], c[2]).normalized();
+        const double h = length(b.cell) * tree.unit();
+        const int tb = th < 0 ? 9 : std::min(8, static_cast<int>(th / h));
+        const std::string k2 = std::string("wall thick/h ") + std::to_string(tb) + (split < 0 ? " split" : " one") +
+                               (std::abs(nf.dot(radial)) < 0.5 ? " riser" : " tread");
+        ++tally[k2][bad ? 1 : 0];
+        if (bad && std::getenv("FEBEMESH_FOLD_WHERE"))
+          std::printf("  FOLDAT %s %s x %.4f r %.4f ang %.1f h %.4f th %.4f\n", k2.c_str(), names[classify_octant(k, false)], c[0], r,
+                      std::atan2(c[2], c[1]) * 57.29577951308232, h, th);
+      }
+    }
+    for (const auto& [key, n] : tally) std::printf("  FOLDSTAT %-32s folded %6d  unfolded %7d\n", key.c_str(), n[1], n[0]);
   }
   {
     // Face nodes with free faces on both sides along an axis (a slab one octant thick): no

@@ -317,6 +317,18 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   const Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
   Flags in = interior_flags(classify(tree, s));
   {
+    // The whole-face buffer (Options3d::flat_buffer): only octants with a free face near the
+    // surface at all its corners and its centre, so fewer than the buffer rule at the same
+    // fraction; the same on threads, and nothing more to drop once it is done.
+    Flags flat = in, flat3 = in, any = in;
+    const std::size_t n_flat = apply_buffer(tree, flat, s, 0.6, 1, true);
+    CHECK(n_flat > 0);
+    CHECK(n_flat < apply_buffer(tree, any, s, 0.6));
+    CHECK(apply_buffer(tree, flat3, s, 0.6, 3, true) == n_flat);
+    CHECK(flat3 == flat);
+    CHECK(apply_buffer(tree, flat, s, 0.6, 1, true) == 0);
+  }
+  {
     // The buffer rule's distances on threads: the same octants dropped.
     Flags in3 = in;
     const std::size_t dropped = apply_buffer(tree, in, s, 0.2);
