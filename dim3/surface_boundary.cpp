@@ -412,15 +412,17 @@ double SurfaceBoundary::control_level(const Box<3>& box) const {
   tree_.for_each_in_box(box, [&](std::int32_t t) {
     if (level >= cap) return;
     const auto& q = tree_.points(t);
-    const auto wanted_at = [&](bool feature) {
+    const auto wanted_at = [&](bool feature, double thick_level) {
       return std::max(std::min(std::max(curvature_level_[t], feature ? feature_level : level), options_.max_level),
-                      std::min(thickness_level_[t], options_.thickness_max_level));
+                      std::min(thick_level, options_.thickness_max_level));
     };
-    double wanted = wanted_at(near_feature_[t]);
+    bool feature = near_feature_[t];
+    double wanted = wanted_at(feature, thickness_level_[t]);
     if (wanted <= level) return;
     if (!box_triangle_overlap(box, q[0], q[1], q[2])) return;
-    if (near_feature_[t] && options_.feature_level_at_edges && !feature_in_box(t, box)) {
-      wanted = wanted_at(false);
+    if (feature && options_.feature_level_at_edges && !feature_in_box(t, box)) {
+      feature = false;
+      wanted = wanted_at(feature, thickness_level_[t]);
       if (wanted <= level) return;
     }
     if (!sample_begin_.empty() && sample_begin_[t + 1] > sample_begin_[t]) {
@@ -432,9 +434,7 @@ double SurfaceBoundary::control_level(const Box<3>& box) const {
         const P3 d = (sample_point_[k].array().max(box.lo.array()).min(box.hi.array())).matrix() - sample_point_[k];
         if (d.squaredNorm() <= reach2) thick_level = sample_level_[k];
       }
-      const bool feature = near_feature_[t] && !(options_.feature_level_at_edges && !feature_in_box(t, box));
-      wanted = std::max(std::min(std::max(curvature_level_[t], feature ? feature_level : level), options_.max_level),
-                        std::min(thick_level, options_.thickness_max_level));
+      wanted = wanted_at(feature, thick_level);
       if (wanted <= level) return;
     }
     level = wanted;
