@@ -36,8 +36,8 @@ void reexec_with_huge_page_heap(char** argv);
 /// did not pay, in interleaved pairs, one thread: bench_mesh3d sphere966 L6 slower with it in 7
 /// of 7 (4.05-5.43 s wall, system 0.21-1.18 s, against 3.85-4.10 s, 0.05-0.08 s), bench_mesh2d
 /// flange 1e6 in 5 of 7 (4.04-7.95 s against 3.57-5.32 s), the CLI on sphere966 L6 (which
-/// also validates and writes mesh.vtu) in 3 of 7 (5.64-7.34 s against 5.88-6.82 s). The
-/// arrays that reserve_huge advises keep their advice.
+/// also validates and writes mesh.vtu) in 3 of 7 (5.64-7.34 s against 5.88-6.82 s). The same
+/// variable turns on reserve_huge's advice (core/huge_pages.hpp; off since session 26).
 void set_up_heap(char** argv);
 
 }  // namespace febemesh

@@ -3,19 +3,36 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <vector>
 
 #include <sys/mman.h>
 
 namespace febemesh {
 
+/// Whether huge pages are wanted: FEBEMESH_HUGE_PAGES=1 in the environment (read once). Off by
+/// default: on the Firecracker VM of sessions 25-26 (free page reporting to the host, THP defrag
+/// on madvise) a fresh 2 MiB page's first touch cost ~20x a 4 KiB page's (512 MB touched once
+/// after a pause: 102-145 MB/s advised, 2.4-2.8 GB/s not), and the advised arrays of a 3D run
+/// were faulted in serial stretches of 0.1-0.3 s (perf, sphere966 L6 on two threads).
+inline bool huge_pages_wanted() {
+  static const bool wanted = [] {
+    const char* v = std::getenv("FEBEMESH_HUGE_PAGES");
+    return v != nullptr && std::strcmp(v, "1") == 0;
+  }();
+  return wanted;
+}
+
 /// Asks for transparent huge pages on the 2 MiB-aligned part of [p, p + bytes). Page faults and
 /// their zeroing are a large part of writing millions of leaves (measured: refinement spends a
 /// third of its time in the kernel with 4 KiB pages), and a 2 MiB page costs one fault instead
 /// of 512. Call it before the pages are first touched. Advice only: ignored where the kernel
-/// does not support it, and the resident set grows by at most one partly used huge page.
+/// does not support it, and the resident set grows by at most one partly used huge page. Only
+/// when huge_pages_wanted().
 inline void advise_huge_pages(const void* p, std::size_t bytes) {
 #ifdef MADV_HUGEPAGE
+  if (!huge_pages_wanted()) return;
   constexpr std::uintptr_t huge = std::uintptr_t(1) << 21;
   const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + huge - 1) & ~(huge - 1);
   const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(huge - 1);
