@@ -472,10 +472,21 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   // rounding; their qualities decide (sphere966 L6: 0.067 s a scan of 1.5 M tetrahedra by
   // quality, 3 scans a run).
   const double below_rank = tet_search_rank_of_angle(below) + 1e-9;
+  // With ranks handed in, the scan reads them; with ranks wanted out, it keeps those it makes.
+  std::vector<double>* ranks = opt.ranks;
+  const bool ranked = ranks && ranks->size() == mesh.solid.size();
+  if (ranks && !ranked) ranks->resize(mesh.solid.size());
   for_each_chunk(static_cast<std::size_t>(w.n_input), chunk, opt.n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       const Tet n = w.tet(static_cast<std::int32_t>(t));
-      if (!(tet_search_rank(mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]) < below_rank)) continue;
+      double r = 0.0;
+      if (ranked) {
+        r = (*ranks)[t];
+      } else {
+        r = tet_search_rank(mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]);
+        if (ranks) (*ranks)[t] = r;
+      }
+      if (!(r < below_rank)) continue;
       if (const double q = w.quality(n); q < below) bad_in[c].push_back({q, static_cast<std::int32_t>(t)});
     }
   });
@@ -566,6 +577,17 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   per_element(mesh.level);
   per_element(mesh.from_boundary_cell);
   if (cell) per_element(*cell);
+  if (ranks) {  // the survivors' in order, then the new ones ranked
+    std::size_t k = 0;
+    for (std::int32_t t = 0; t < w.n_input; ++t)
+      if (w.alive[t]) (*ranks)[k++] = (*ranks)[t];
+    ranks->resize(k);
+    for (std::size_t i = 0; i < w.added.size(); ++i)
+      if (w.alive[w.n_input + i]) {
+        const Tet& n = w.added[i];
+        ranks->push_back(tet_search_rank(mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]));
+      }
+  }
   Elements& solid = mesh.solid;
   std::size_t k = 0;
   for (std::int32_t t = 0; t < w.n_input; ++t) {

@@ -73,6 +73,11 @@ struct EdgeRemovalOptions {
   /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
   /// on one); the result is the same for every count.
   int n_threads = 1;
+  /// tet_search_rank of every tetrahedron, handed between passes (TetOptimizeOptions::ranks).
+  /// In: when it holds one value a tetrahedron, those of the input at its points, which the scan
+  /// uses instead of ranking them all; otherwise they are ranked. Out: those of the output
+  /// tetrahedra (the survivors' as handed in or ranked, the new ones ranked). Null: neither.
+  std::vector<double>* ranks = nullptr;
 };
 
 struct EdgeRemovalStats {

@@ -974,6 +974,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         to.project = surface_point;
         to.surface_normal = surface_normal;
         to.n_threads = opt.n_threads;
+        // The ranks go from each pass to the next (the points do not move in between).
+        std::vector<double> ranks;
+        to.ranks = &ranks;
         const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
         r.n_optimize_moves = ts.moves;
         if (opt.slide_feature_nodes && slide_on_lines(s, oc.complex, fe, to) > 0) {
@@ -1012,6 +1015,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           eo.surface_normal = surface_normal;
           eo.n_threads = opt.n_threads;
           eo.contract_below_deg = opt.contract_edges_below_deg;
+          eo.ranks = &ranks;
           // Contractions keep the corners. Nodes snapped onto a feature line may go (into a node
           // of theirs): those the sweeps keep fixed include some whose closest point is on a
           // face beside the line (fandisk L5: the smooth-surface end of a 0.0012 edge whose

@@ -185,6 +185,8 @@ struct Optimizer {
   /// The search rank of every tetrahedron at the current points: tet_search_rank at the
   /// start, then MovingTet::rank from the node that last moved (the same formula, to rounding).
   std::vector<double> tet_q;
+  /// Per tetrahedron, 1 once a move re-ranked it (only when opt.ranks is handed back).
+  std::vector<std::uint8_t> moved_tet;
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
   double tangent_rank = 0.0;  ///< angle_rank of opt.tangent_below_deg
   bool avx = has_avx();  ///< rank four lanes at a time in AVX registers
@@ -537,6 +539,8 @@ struct Optimizer {
     // The ranks at the new point were computed for the accepted candidate (all of them: it
     // was not stopped early).
     for (std::int32_t k = start[v]; k < start[v + 1]; ++k) tet_q[incident[k]] = best_ranks[k - start[v]];
+    if (!moved_tet.empty())  // (v's tetrahedra: no other node visited meanwhile shares one)
+      for (std::int32_t k = start[v]; k < start[v + 1]; ++k) moved_tet[incident[k]] = 1;
     if (surf) where[v] = best_w;
     if (guard) normals[static_cast<std::size_t>(normal_slot[v])] = opt.surface_normal(best_w);
     return true;
@@ -593,7 +597,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 }
 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
-  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
+  Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
   const std::size_t n = mesh.points.size();
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
@@ -645,7 +649,14 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
   const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
   std::vector<std::uint8_t> active(n, 0);
-  o.tet_q.resize(o.tets.size());
+  // The ranks handed in (the last pass's, at these points), else every tetrahedron ranked:
+  // one such scan was 37 ms of sphere966 L6's pipeline, seven a run (three sweeps' passes,
+  // three edge removal rounds, the untangling).
+  const bool ranked = opt.ranks && opt.ranks->size() == o.tets.size();
+  if (ranked)
+    o.tet_q.swap(*opt.ranks);
+  else
+    o.tet_q.resize(o.tets.size());
   o.target_rank = angle_rank(target);
   o.tangent_rank = angle_rank(opt.tangent_below_deg * pi / 180.0);
   std::atomic<bool> some_active{false};
@@ -653,7 +664,8 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     bool here = false;
     for (std::size_t i = begin; i < end; ++i) {
       const Tet& t = o.tets[i];
-      const double q = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+      const double q =
+          ranked ? o.tet_q[i] : tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
       o.tet_q[i] = q;
       if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
         here = true;
@@ -675,8 +687,10 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     st.sweeps = opt.max_sweeps > 0 ? 1 : 0;
     st.inverted_after = st.inverted_before, st.min_dihedral_after_deg = st.min_dihedral_before_deg;
     st.folded_after = st.folded_before;
+    if (opt.ranks) opt.ranks->swap(o.tet_q);
     return st;
   }
+  if (opt.ranks) o.moved_tet.assign(o.tets.size(), 0);
   // Node -> tetrahedra only now: the untangling pass before smoothing usually finds nothing to
   // do (sphere966 L6: 0.07 s of lists for 1.5 M tetrahedra, none inverted).
   incidence_csr(
@@ -734,6 +748,16 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
   }
   measure(st.inverted_after, st.min_dihedral_after_deg);
   st.folded_after = count_folded();
+  if (opt.ranks) {
+    for_each_range(o.tets.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        if (o.moved_tet[i]) {
+          const Tet& t = o.tets[i];
+          o.tet_q[i] = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+        }
+    });
+    opt.ranks->swap(o.tet_q);
+  }
   return st;
 }
 

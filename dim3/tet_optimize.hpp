@@ -76,6 +76,13 @@ struct TetOptimizeOptions {
   /// Threads for the sweeps (project and surface_normal must then be safe to call
   /// concurrently); the result is the same, bit for bit, for every count.
   int n_threads = 1;
+  /// The tetrahedra's search ranks handed from one pass to the next (the pipeline's sweeps and
+  /// edge removal rounds; EdgeRemovalOptions::ranks). In: when it holds one value a
+  /// tetrahedron, tet_search_rank of each at the current points (the caller vouches for it),
+  /// used instead of ranking them all again; otherwise they are ranked. Out: tet_search_rank of
+  /// each at the end, the moved ones' ranked again (the sweeps' own ranks differ to rounding),
+  /// so the next pass gets the numbers it would compute. Null: neither.
+  std::vector<double>* ranks = nullptr;
 };
 
 struct TetOptimizeStats {

@@ -1,6 +1,7 @@
 // tet_optimize: the search rank (no acos) orders tetrahedra like the angle-based search quality
 // (its slow twin) and has its sign; the optimiser never lowers the worst dihedral angle or
-// inverts a tetrahedron, and gives the same mesh when run twice and on any number of threads.
+// inverts a tetrahedron, and gives the same mesh when run twice and on any number of threads;
+// the ranks handed from pass to pass are those a pass would compute.
 
 #include <catch2/catch.hpp>
 #include <rapidcheck.h>
@@ -10,6 +11,7 @@
 #include <utility>
 
 #include "core/mesh.hpp"
+#include "dim3/edge_removal.hpp"
 #include "dim3/tet_optimize.hpp"
 #include "property.hpp"
 #include "core/test_mesh_fixtures.hpp"
@@ -220,4 +222,74 @@ TEST_CASE("optimize_tets slides feature-line nodes along their lines only", "[te
     moved += m.points[v] != start.points[v] ? 1 : 0;
   }
   CHECK(moved > 0);
+}
+
+namespace {
+
+/// tet_search_rank of every tetrahedron of m, in element order.
+std::vector<double> ranks_of(const Mesh<3>& m) {
+  std::vector<double> r;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const VertexId* v = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    r.push_back(tet_search_rank(m.points[v[0].v], m.points[v[1].v], m.points[v[2].v], m.points[v[3].v]));
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("ranks handed between sweeps and edge removal are a pass's own, and change nothing", "[tet_optimize][edge_removal]") {
+  // The pipeline's order: sweeps, then edge removal rounds each followed by sweeps; once
+  // ranking every tetrahedron in each pass, once handing the ranks on. Same mesh, bit for bit,
+  // and the ranks handed out are tet_search_rank's at the end of every pass.
+  for (const unsigned seed : {5u, 6u}) {
+    const int n = 9;
+    const Mesh<3> start = jittered_cube(0.7, seed, n);
+    std::vector<BoundaryLocation> where(start.points.size());
+    TetOptimizeOptions to;
+    to.max_sweeps = 6;
+    to.fixed.assign(start.points.size(), 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v)
+      to.fixed[v] = start.points[v].minCoeff() == 0.0 || start.points[v].maxCoeff() == n - 1.0 ? 1 : 0;
+    EdgeRemovalOptions eo;
+    eo.below_deg = 30.0;
+    eo.contract_below_deg = 20.0;
+    for (const int threads : {1, 2}) {
+      Mesh<3> plain = start, handed = start;
+      std::vector<BoundaryLocation> where_plain = where, where_handed = where;
+      TetOptimizeOptions to_plain = to, to_handed = to;
+      to_plain.n_threads = to_handed.n_threads = threads;
+      EdgeRemovalOptions eo_plain = eo, eo_handed = eo;
+      std::vector<double> ranks;
+      to_handed.ranks = &ranks;
+      eo_handed.ranks = &ranks;
+      std::size_t moves = 0, removed = 0;
+      CAPTURE(seed, threads);
+      for (int pass = 0; pass < 3; ++pass) {
+        const TetOptimizeStats a = optimize_tets(plain, where_plain, to_plain);
+        const TetOptimizeStats b = optimize_tets(handed, where_handed, to_handed);
+        CAPTURE(pass);
+        CHECK(a.moves == b.moves);
+        CHECK(a.min_dihedral_after_deg == b.min_dihedral_after_deg);
+        REQUIRE(handed.points == plain.points);
+        CHECK(ranks == ranks_of(handed));
+        moves += a.moves;
+        const EdgeRemovalStats ea = remove_bad_edges(plain, where_plain, nullptr, eo_plain);
+        const EdgeRemovalStats eb = remove_bad_edges(handed, where_handed, nullptr, eo_handed);
+        remap_nodes(ea.node_map, to_plain.fixed);
+        remap_nodes(ea.node_map, where_plain);
+        remap_nodes(eb.node_map, to_handed.fixed);
+        remap_nodes(eb.node_map, where_handed);
+        CHECK(ea.removed == eb.removed);
+        CHECK(ea.contracted == eb.contracted);
+        REQUIRE(handed.solid.node == plain.solid.node);
+        REQUIRE(handed.points == plain.points);
+        CHECK(ranks == ranks_of(handed));
+        removed += ea.removed + ea.contracted;
+      }
+      // The sequence did something to hand on.
+      CHECK(moves > 0);
+      CHECK(removed > 0);
+    }
+  }
 }
