@@ -6,6 +6,7 @@
 
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/partitioned_sweep.hpp"
 #include "core/quality.hpp"
 #include "core/smooth.hpp"
@@ -28,17 +29,24 @@ std::string describe(const std::vector<Problem>& problems) {
   return os.str();
 }
 
-/// Elements that came out inverted (or flat), as problems at their centroids.
-std::vector<Problem> inverted_elements(const Mesh<2>& m) {
+/// Elements that came out inverted (or flat), as problems at their centroids, in element order;
+/// checked in fixed chunks on n_threads threads (serial, it was 0.1 s of the flange's 2.5 s at
+/// 5.4 M triangles on two threads).
+std::vector<Problem> inverted_elements(const Mesh<2>& m, int n_threads) {
+  const std::size_t chunk = chunk_size(m.solid.size(), n_threads, 1 << 14);
+  std::vector<std::vector<Problem>> found((m.solid.size() + chunk - 1) / chunk);
+  for_each_chunk(m.solid.size(), chunk, n_threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) {
+      const ElemId id{static_cast<std::int32_t>(e)};
+      const auto pts = element_points<2>(m.solid, id, m.points);
+      if (min_corner_jacobian<2>(m.solid.type[e], pts.span()) > 0) continue;
+      Point<2> c = Point<2>::Zero();
+      for (int i = 0; i < pts.n; ++i) c += pts.p[i];
+      found[k].push_back({c / pts.n, "an element is inverted"});
+    }
+  });
   std::vector<Problem> out;
-  for (std::size_t e = 0; e < m.solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    const auto pts = element_points<2>(m.solid, id, m.points);
-    if (min_corner_jacobian<2>(m.solid.type[e], pts.span()) > 0) continue;
-    Point<2> c = Point<2>::Zero();
-    for (int k = 0; k < pts.n; ++k) c += pts.p[k];
-    out.push_back({c / pts.n, "an element is inverted"});
-  }
+  for (const std::vector<Problem>& f : found) out.insert(out.end(), f.begin(), f.end());
   return out;
 }
 
@@ -201,7 +209,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
         settle_interface();
         clock.lap("angle optimisation");
       }
-      problems = inverted_elements(fe.mesh);
+      problems = inverted_elements(fe.mesh, opt.n_threads);
     }
     if (problems.empty()) {
       r.stats = bq.stats;
