@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "core/mesh_topology.hpp"
@@ -216,7 +217,68 @@ std::pair<double, double> tet_jacobians(std::span<const Point<3>> p) {
   return {m, std::clamp(s * normalisation(ElemType::Tet4), -1.0, 1.0)};
 }
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define FEBEMESH_TET_LANES 1
+// Four tetrahedra a vector, lane by lane the operations of tet_jacobians in its order: Eigen's
+// 3-vector cross product (a1 b2 - a2 b1, a2 b0 - a0 b2, a0 b1 - a1 b0), its dot products and
+// squared norms summed left to right ((x0 + x1) + x2), sqrt, no fused multiply-add (the build
+// targets no FMA, and this function only AVX), std::min and std::clamp's comparisons as written
+// (a NaN lane passes through as there). Plain code, no helpers: a lambda or function taking
+// vectors would not inherit the target (-Wpsabi, and no inlining across targets).
+[[gnu::target("avx")]] void tet_jacobians_avx(const Point<3>* p, std::size_t n_blocks, double* jac, double* scaled) {
+  using V = double __attribute__((vector_size(32)));
+  const double root2 = normalisation(ElemType::Tet4);
+  for (std::size_t b = 0; b < n_blocks; ++b) {
+    const Point<3>* q = p + 16 * b;
+    V x[4][3];  // corner, coordinate; lanes = the block's tetrahedra
+    for (int c = 0; c < 4; ++c)
+      for (int d = 0; d < 3; ++d) x[c][d] = V{q[c][d], q[4 + c][d], q[8 + c][d], q[12 + c][d]};
+    // e[i][j] = x[j] - x[i] for the differences tet_jacobians takes.
+    V e01[3], e02[3], e03[3], e12[3], e13[3], e23[3], e10[3], e20[3], e21[3], e30[3], e32[3], e31[3];
+    for (int d = 0; d < 3; ++d) {
+      e01[d] = x[1][d] - x[0][d], e02[d] = x[2][d] - x[0][d], e03[d] = x[3][d] - x[0][d];
+      e12[d] = x[2][d] - x[1][d], e13[d] = x[3][d] - x[1][d], e23[d] = x[3][d] - x[2][d];
+      e10[d] = x[0][d] - x[1][d], e20[d] = x[0][d] - x[2][d], e21[d] = x[1][d] - x[2][d];
+      e30[d] = x[0][d] - x[3][d], e32[d] = x[2][d] - x[3][d], e31[d] = x[1][d] - x[3][d];
+    }
+#define FEBEMESH_NORM(e) __builtin_ia32_sqrtpd256(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+#define FEBEMESH_DET(a, b, c)                                                                 \
+  (a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]))
+    const V l01 = FEBEMESH_NORM(e01), l02 = FEBEMESH_NORM(e02), l03 = FEBEMESH_NORM(e03),
+            l12 = FEBEMESH_NORM(e12), l13 = FEBEMESH_NORM(e13), l23 = FEBEMESH_NORM(e23);
+    const V j[4] = {FEBEMESH_DET(e01, e02, e03), FEBEMESH_DET(e12, e10, e13), FEBEMESH_DET(e20, e21, e23),
+                    FEBEMESH_DET(e30, e32, e31)};
+#undef FEBEMESH_NORM
+#undef FEBEMESH_DET
+    const V len[4] = {l01 * l02 * l03, l12 * l01 * l13, l02 * l12 * l23, l03 * l23 * l13};
+    const V zero = V{0, 0, 0, 0};
+    V m = V{inf, inf, inf, inf}, s = m;
+    for (int k = 0; k < 4; ++k) {
+      m = j[k] < m ? j[k] : m;                          // std::min(m, j[k])
+      const V r = len[k] > zero ? j[k] / len[k] : zero;  // (a lane of len 0 divides, unused)
+      s = r < s ? r : s;
+    }
+    s = s * root2;
+    const V lo = V{-1, -1, -1, -1}, hi = V{1, 1, 1, 1};
+    s = s < lo ? lo : (hi < s ? hi : s);  // std::clamp
+    for (int k = 0; k < 4; ++k) jac[4 * b + k] = m[k], scaled[4 * b + k] = s[k];
+  }
+}
+#endif
+
 }  // namespace
+
+void tet_jacobians_n(const Point<3>* p, std::size_t n, double* jac, double* scaled) {
+  std::size_t done = 0;
+#ifdef FEBEMESH_TET_LANES
+  static const bool avx = __builtin_cpu_supports("avx");
+  if (avx) {
+    tet_jacobians_avx(p, n / 4, jac, scaled);
+    done = n / 4 * 4;
+  }
+#endif
+  for (std::size_t t = done; t < n; ++t) std::tie(jac[t], scaled[t]) = tet_jacobians(std::span<const Point<3>>(p + 4 * t, 4));
+}
 
 template <int Dim> double min_corner_jacobian(ElemType t, std::span<const Point<Dim>> p) {
   MESH_ASSERT(static_cast<int>(p.size()) == n_nodes(t), name(t) << " with " << p.size() << " points");

@@ -34,6 +34,10 @@ template <int Dim> double scaled_jacobian(ElemType t, std::span<const Point<Dim>
 /// Both at once, {min_corner_jacobian, scaled_jacobian} (the same values; one pass over the
 /// corners, for the smoothing guard that needs both per trial move).
 template <int Dim> std::pair<double, double> jacobians(ElemType t, std::span<const Point<Dim>> p);
+/// jacobians(Tet4, ...) of n tetrahedra, those of tetrahedron i at p[4 i .. 4 i + 3]:
+/// {jac[i], scaled[i]}, the same numbers bit for bit, four tetrahedra at a time in AVX registers
+/// where the CPU has them (the 3D smoothing guard, which ranks all of a node's tetrahedra).
+void tet_jacobians_n(const Point<3>* p, std::size_t n, double* jac, double* scaled);
 /// jacobians() of a triangle (n = 3) or quadrilateral (n = 4) in the plane, with `normalise`
 /// 2/sqrt(3) or 1: corner i spans edges e[i] = p[i+1] - p[i] and -e[i-1], so each edge length is
 /// taken once and reused (a vector and its negation have the same norm, bit for bit); the same

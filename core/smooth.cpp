@@ -255,7 +255,27 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     for (const double sj : scaled) q = std::min(q, sj);
     return scaled.empty() ? 0.0 : q;
   };
+  // Tetrahedra only: their states four at a time (tet_jacobians_n, the same numbers).
+  const bool all_tets = Dim == 3 && std::all_of(mesh.solid.type.begin(), mesh.solid.type.end(),
+                                                [](ElemType t) { return t == ElemType::Tet4; });
   for_each_range(mesh.solid.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
+    if constexpr (Dim == 3) {
+      if (all_tets) {
+        constexpr std::size_t block = 256;
+        std::vector<Point<3>> pts(4 * block);
+        std::array<double, block> jac{}, sj{};
+        for (std::size_t first = begin; first < end; first += block) {
+          const std::size_t n_here = std::min(block, end - first);
+          for (std::size_t i = 0; i < n_here; ++i) {
+            const VertexId* v = mesh.solid.nodes(ElemId{static_cast<std::int32_t>(first + i)});
+            for (int k = 0; k < 4; ++k) pts[4 * i + k] = mesh.points[v[k].v];
+          }
+          tet_jacobians_n(pts.data(), n_here, jac.data(), sj.data());
+          for (std::size_t i = 0; i < n_here; ++i) set_state(static_cast<std::int32_t>(first + i), {jac[i] > 0.0, sj[i]});
+        }
+        return;
+      }
+    }
     for (std::size_t e = begin; e < end; ++e) set_state(static_cast<std::int32_t>(e), element_state(static_cast<std::int32_t>(e)));
   });
   stats.min_quality_before = min_quality();
@@ -303,6 +323,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   }
   struct alignas(64) PerThread {
     std::vector<std::pair<bool, double>> after;
+    std::vector<Point<Dim>> pts;     ///< the tetrahedra's points (all_tets)
+    std::vector<double> jac, sj;     ///< their states (all_tets)
     std::vector<std::int32_t> nbrs;    ///< gathered neighbours (gather)
     std::vector<std::uint8_t> listed;  ///< their marks (gather)
     std::size_t accepted = 0, rejected = 0;
@@ -347,15 +369,41 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     }
     const Point<Dim> saved = mesh.points[v];
     mesh.points[v] = target;
-    // Accepted iff no valid element inverts and every element stays >= old_min: the first
-    // element that fails decides, the element that held old_min (likeliest to drop) first.
     bool accept = true;
     std::vector<std::pair<bool, double>>& after = my.after;
     after.resize(elems.size());
-    for (std::size_t j = 0; j < elems.size() && accept; ++j) {
-      const std::size_t k = worst_first(j, worst);
-      after[k] = element_state(elems[k]);
-      accept = (after[k].first || !valid[elems[k]]) && after[k].second >= old_min;
+    const auto passes = [&](std::size_t k) { return (after[k].first || !valid[elems[k]]) && after[k].second >= old_min; };
+    bool lanes = false;
+    if constexpr (Dim == 3) lanes = all_tets;
+    if (lanes) {
+      // The worst alone first (most rejections stop there), then all of them four at a time:
+      // the same states, and the same verdict (every element must pass either way).
+      after[worst] = element_state(elems[worst]);
+      accept = passes(worst);
+      if constexpr (Dim == 3) {
+        if (accept && elems.size() > 1) {
+          my.pts.resize(4 * elems.size());
+          my.jac.resize(elems.size());
+          my.sj.resize(elems.size());
+          for (std::size_t k = 0; k < elems.size(); ++k) {
+            const VertexId* ev = mesh.solid.nodes(ElemId{elems[k]});
+            for (int i = 0; i < 4; ++i) my.pts[4 * k + i] = mesh.points[ev[i].v];
+          }
+          tet_jacobians_n(my.pts.data(), elems.size(), my.jac.data(), my.sj.data());
+          for (std::size_t k = 0; k < elems.size() && accept; ++k) {
+            after[k] = {my.jac[k] > 0.0, my.sj[k]};
+            accept = passes(k);
+          }
+        }
+      }
+    } else {
+      // Accepted iff no valid element inverts and every element stays >= old_min: the first
+      // element that fails decides, the element that held old_min (likeliest to drop) first.
+      for (std::size_t j = 0; j < elems.size() && accept; ++j) {
+        const std::size_t k = worst_first(j, worst);
+        after[k] = element_state(elems[k]);
+        accept = passes(k);
+      }
     }
     if (accept) {
       ++my.accepted;
