@@ -637,11 +637,23 @@ QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_
   return s;
 }
 
-template <int Dim> double solid_measure(const Mesh<Dim>& mesh) {
+template <int Dim> double solid_measure(const Mesh<Dim>& mesh, int n_threads) {
+  // The elements' measures a block at a time on n_threads threads, summed in element order on
+  // one: the serial sum, bit for bit, for every count (serial, it was 0.08 s of sphere966 L6's
+  // 2.9 s on two threads), and 2 MB beside the mesh.
+  constexpr std::size_t block = std::size_t(1) << 18;
+  std::vector<double> part(std::min(block, mesh.solid.size()));
   double m = 0.0;
-  for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
-    const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
-    m += signed_measure<Dim>(mesh.solid.type[e], ep.span());
+  for (std::size_t first = 0; first < mesh.solid.size(); first += block) {
+    const std::size_t n_here = std::min(block, mesh.solid.size() - first);
+    for_each_range(n_here, n_threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::size_t e = first + i;
+        const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+        part[i] = signed_measure<Dim>(mesh.solid.type[e], ep.span());
+      }
+    });
+    for (std::size_t i = 0; i < n_here; ++i) m += part[i];
   }
   return m;
 }
@@ -683,7 +695,7 @@ template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh) {
   template ElemPoints<D> element_points<D>(const Elements&, ElemId, const std::vector<Point<D>>&); \
   template std::vector<double> scaled_jacobians<D>(const Elements&, const std::vector<Point<D>>&); \
   template QualitySummary summarize_quality<D>(const Mesh<D>&, double, int);                       \
-  template double solid_measure<D>(const Mesh<D>&);                                                \
+  template double solid_measure<D>(const Mesh<D>&, int);                                           \
   template double interface_enclosed_measure<D>(const Mesh<D>&);
 FEBEMESH_INSTANTIATE(2)
 FEBEMESH_INSTANTIATE(3)

@@ -95,8 +95,9 @@ struct QualitySummary {
 template <int Dim>
 QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_deg = 10.0, int n_threads = 1);
 
-/// Area (2D) / volume (3D) of the solid elements, signed.
-template <int Dim> double solid_measure(const Mesh<Dim>& mesh);
+/// Area (2D) / volume (3D) of the solid elements, signed; summed in element order, the elements'
+/// measures taken on n_threads threads (the same sum for every count).
+template <int Dim> double solid_measure(const Mesh<Dim>& mesh, int n_threads = 1);
 /// Area of the polygons (2D) / volume of the surface (3D) bounded by the interface elements,
 /// by the divergence theorem; equals solid_measure when the interface is the outward boundary.
 template <int Dim> double interface_enclosed_measure(const Mesh<Dim>& mesh);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <optional>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/point_grid.hpp"
@@ -341,64 +343,71 @@ namespace {
 /// euler_characteristic of a solid of tetrahedra with four distinct nodes each, without sorting
 /// all edges and faces: each edge and face is counted at its smallest node, edges by marking
 /// the larger neighbours, faces by sorting the node's few (larger, larger) pairs. Empty when an
-/// element is not such a tetrahedron (then the general count runs).
-std::optional<long> tet_euler_characteristic(const Mesh<3>& mesh) {
+/// element is not such a tetrahedron (then the general count runs). The nodes in ranges on
+/// n_threads threads, each with its own marks (integer counts: the same sum for every count;
+/// serial, it was 0.12 s of sphere966 L6's 2.9 s on two threads).
+std::optional<long> tet_euler_characteristic(const Mesh<3>& mesh, int n_threads) {
   const Elements& els = mesh.solid;
   const std::size_t n = mesh.points.size();
-  std::vector<std::int32_t> start(n + 1, 0);
-  for (std::size_t e = 0; e < els.size(); ++e) {
-    if (els.type[e] != ElemType::Tet4) return std::nullopt;
-    const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
-    for (int i = 0; i < 4; ++i) {
-      if (v[i].v < 0 || static_cast<std::size_t>(v[i].v) >= n) return std::nullopt;
-      for (int j = i + 1; j < 4; ++j)
-        if (v[i].v == v[j].v) return std::nullopt;
-      ++start[v[i].v + 1];
-    }
-  }
-  for (std::size_t i = 0; i < n; ++i) start[i + 1] += start[i];
-  std::vector<std::int32_t> incident(static_cast<std::size_t>(start[n]));
-  {
-    std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t e = 0; e < els.size(); ++e) {
+  std::atomic<bool> tets_only{true};
+  for_each_range(els.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t e = begin; e < end; ++e) {
+      if (els.type[e] != ElemType::Tet4) return tets_only.store(false);
       const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
-      for (int i = 0; i < 4; ++i) incident[fill[v[i].v]++] = static_cast<std::int32_t>(e);
-    }
-  }
-  std::vector<std::int32_t> mark(n, -1);
-  std::vector<std::uint64_t> pairs;
-  long nv = 0, ne = 0, nf = 0;
-  for (std::size_t vi = 0; vi < n; ++vi) {
-    if (start[vi] == start[vi + 1]) continue;
-    const std::int32_t v = static_cast<std::int32_t>(vi);
-    ++nv;
-    pairs.clear();
-    for (std::int32_t k = start[vi]; k < start[vi + 1]; ++k) {
-      const VertexId* t = els.nodes(ElemId{incident[k]});
-      std::array<std::int32_t, 3> o{};
-      int m = 0;
-      for (int i = 0; i < 4; ++i)
-        if (t[i].v != v) o[m++] = t[i].v;
-      for (const std::int32_t u : o)
-        if (u > v && mark[u] != v) mark[u] = v, ++ne;
-      // The three faces through v: v with two of the other three nodes.
-      for (int i = 0; i < 3; ++i) {
-        const std::int32_t a = o[(i + 1) % 3], b = o[(i + 2) % 3];
-        if (a > v && b > v)
-          pairs.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)));
+      for (int i = 0; i < 4; ++i) {
+        if (v[i].v < 0 || static_cast<std::size_t>(v[i].v) >= n) return tets_only.store(false);
+        for (int j = i + 1; j < 4; ++j)
+          if (v[i].v == v[j].v) return tets_only.store(false);
       }
     }
-    std::sort(pairs.begin(), pairs.end());
-    nf += std::unique(pairs.begin(), pairs.end()) - pairs.begin();
-  }
-  return nv - ne + nf - static_cast<long>(els.size());
+  });
+  if (!tets_only.load()) return std::nullopt;
+  std::vector<std::int32_t> start, incident;
+  incidence_csr(
+      n, els.size(),
+      [&](std::size_t e, auto&& f) {
+        const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
+        for (int i = 0; i < 4; ++i) f(v[i].v);
+      },
+      n_threads, start, incident);
+  std::atomic<long> total{0};
+  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::int32_t> mark(n, -1);
+    std::vector<std::uint64_t> pairs;
+    long nv = 0, ne = 0, nf = 0;
+    for (std::size_t vi = begin; vi < end; ++vi) {
+      if (start[vi] == start[vi + 1]) continue;
+      const std::int32_t v = static_cast<std::int32_t>(vi);
+      ++nv;
+      pairs.clear();
+      for (std::int32_t k = start[vi]; k < start[vi + 1]; ++k) {
+        const VertexId* t = els.nodes(ElemId{incident[k]});
+        std::array<std::int32_t, 3> o{};
+        int m = 0;
+        for (int i = 0; i < 4; ++i)
+          if (t[i].v != v) o[m++] = t[i].v;
+        for (const std::int32_t u : o)
+          if (u > v && mark[u] != v) mark[u] = v, ++ne;
+        // The three faces through v: v with two of the other three nodes.
+        for (int i = 0; i < 3; ++i) {
+          const std::int32_t a = o[(i + 1) % 3], b = o[(i + 2) % 3];
+          if (a > v && b > v)
+            pairs.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)));
+        }
+      }
+      std::sort(pairs.begin(), pairs.end());
+      nf += std::unique(pairs.begin(), pairs.end()) - pairs.begin();
+    }
+    total += nv - ne + nf;
+  });
+  return total.load() - static_cast<long>(els.size());
 }
 
 }  // namespace
 
-template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh) {
+template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh, int n_threads) {
   if constexpr (Dim == 3) {
-    if (const std::optional<long> x = tet_euler_characteristic(mesh)) return *x;
+    if (const std::optional<long> x = tet_euler_characteristic(mesh, n_threads)) return *x;
   }
   return euler_characteristic_ref(mesh);
 }
@@ -741,8 +750,8 @@ template ValidationReport validate<2>(const Mesh<2>&, const ValidateOptions<2>&)
 template ValidationReport validate<3>(const Mesh<3>&, const ValidateOptions<3>&);
 template bool is_valid<2>(const Mesh<2>&, const ValidateOptions<2>&);
 template bool is_valid<3>(const Mesh<3>&, const ValidateOptions<3>&);
-template long euler_characteristic<2>(const Mesh<2>&);
-template long euler_characteristic<3>(const Mesh<3>&);
+template long euler_characteristic<2>(const Mesh<2>&, int);
+template long euler_characteristic<3>(const Mesh<3>&, int);
 template long euler_characteristic_ref<2>(const Mesh<2>&);
 template long euler_characteristic_ref<3>(const Mesh<3>&);
 

@@ -77,8 +77,8 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
 template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});
 
 /// Euler characteristic of the solid elements alone: V - E + F (2D), V - E + F - C (3D),
-/// V counting only the nodes the solid uses.
-template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh);
+/// V counting only the nodes the solid uses. Tetrahedra are counted on n_threads threads.
+template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh, int n_threads = 1);
 /// The same count by sorting every edge and facet (any element types; the slow twin of the
 /// tetrahedra-only count euler_characteristic uses when it can).
 template <int Dim> long euler_characteristic_ref(const Mesh<Dim>& mesh);

@@ -487,8 +487,8 @@ Options3d facing_try_options(const Options3d& opt) {
 namespace {
 
 /// |volume of the solid elements - the surface's| / the surface's.
-double volume_error(const Mesh<3>& m, const SurfaceBoundary& s) {
-  return std::abs(solid_measure<3>(m) - s.volume()) / std::abs(s.volume());
+double volume_error(const Mesh<3>& m, const SurfaceBoundary& s, int n_threads) {
+  return std::abs(solid_measure<3>(m, n_threads) - s.volume()) / std::abs(s.volume());
 }
 
 /// mesh3d_facing, and when every try is refused although they built on fewer octants than
@@ -613,7 +613,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   Options3d ran = opt;  // the thickness retry below is at the level the mesh was made at
   ran.level += r.level_raised;
   if (!(ran.thin_retry_cells > 0) || ran.thickness_cells > 0) return r;
-  const double error = volume_error(r.fe.mesh, s);
+  const double error = volume_error(r.fe.mesh, s, opt.n_threads);
   if (!(error > ran.thin_retry_error)) return r;
   // Parts thinner than the octants (rotor's blades, spool's flanges at level 4) have no
   // interior octant and are lost; the mesh is valid but misses them. Once more with the
@@ -644,7 +644,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     Result3d t = mesh3d_facing(s, thin, thin_effort, progress);
     t.n_octants_built = r.n_octants_built + thin_effort.used;
     const ValidationReport v = validate(t.fe.mesh, surface_validation(s));
-    const double t_error = volume_error(t.fe.mesh, s);
+    const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);
     if (progress)
       progress("thin parts: the mesh is " + std::string(v.valid ? "valid" : "not valid (" + v.summary() + ")") +
                ", volume error " + std::to_string(100 * t_error) + "%");
@@ -1086,7 +1086,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the
       // solid's Euler characteristic is not half the surface's): refine the octants the
       // surface crosses once more and rebuild, rather than keep a mesh that misses them.
-      const long euler = euler_characteristic<3>(fe.mesh);
+      const long euler = euler_characteristic<3>(fe.mesh, opt.n_threads);
       const bool topology_wrong = s.euler_characteristic() % 2 == 0 && euler != s.euler_characteristic() / 2;
       // Not for islands alone where the island trial showed that one level more does not
       // resolve them: refining every octant on the surface is that refinement and more (rotor

@@ -337,7 +337,17 @@ TEST_CASE("euler_characteristic of tetrahedra agrees with its sorting twin", "[v
     });
     CAPTURE(seed);
     CHECK(euler_characteristic(m) == euler_characteristic_ref(m));
+    for (const int threads : {2, 3}) CHECK(euler_characteristic(m, threads) == euler_characteristic_ref(m));
   }
+  // Large enough (about 74,600 of 82,944 tetrahedra kept) that the node lists are built on
+  // several threads too.
+  std::uint64_t s = 99;
+  const Mesh<3> big = kuhn_cube(24, [&](std::size_t) {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(s >> 11) / double(1ULL << 53) < 0.9;
+  });
+  const long want = euler_characteristic_ref(big);
+  for (const int threads : {1, 2, 3}) CHECK(euler_characteristic(big, threads) == want);
   // A tetrahedron with a repeated node: the general count.
   Mesh<3> bad = kuhn_cube(1, [](std::size_t i) { return i == 0; });
   bad.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{1}, VertexId{1}, VertexId{7}});
