@@ -144,33 +144,38 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     return g;
   }
   // Each thread's marks: seen[w] == v while v's list is made, uses[w] counts v's uses of w.
-  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
-                   std::vector<std::int32_t> seen(n, -1);
-                   for (std::size_t v = begin; v < end; ++v) {
-                     const auto self = static_cast<std::int32_t>(v);
-                     std::int32_t count = 0;
-                     each_use(self, [&](std::int32_t w) {
-                       if (seen[w] == self) return;
-                       seen[w] = self;
-                       count += w == self ? 2 : 1;  // v itself twice
-                     });
-                     g.start[v + 1] = count;
-                   }
-                 });
+  // Node chunks go to the threads as they come free: a node's cost is its elements', and the
+  // surface nodes come last.
+  const std::size_t chunk = std::size_t(1) << 12;
+  for_each_chunk_balanced(n, chunk, n_threads, [&](auto&& next) {
+    std::vector<std::int32_t> seen(n, -1);
+    for (std::size_t begin = 0, end = 0; next(begin, end);)
+      for (std::size_t v = begin; v < end; ++v) {
+        const auto self = static_cast<std::int32_t>(v);
+        std::int32_t count = 0;
+        each_use(self, [&](std::int32_t w) {
+          if (seen[w] == self) return;
+          seen[w] = self;
+          count += w == self ? 2 : 1;  // v itself twice
+        });
+        g.start[v + 1] = count;
+      }
+  });
   for (std::size_t v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
   reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
   g.item.resize(static_cast<std::size_t>(g.start[n]));
-  for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
-                   std::vector<std::int32_t> seen(n, -1), uses;
-                   if (once) uses.assign(n, 0);
-                   for (std::size_t v = begin; v < end; ++v) {
-                     const auto self = static_cast<std::int32_t>(v);
-                     std::int32_t out = g.start[v];
-                     const bool has_self =
-                         distinct_uses(self, seen, uses, [&](std::int32_t w) { g.item[static_cast<std::size_t>(out++)] = w; });
-                     finish(self, g.item.begin() + g.start[v], g.item.begin() + out, has_self, uses);
-                   }
-                 });
+  for_each_chunk_balanced(n, chunk, n_threads, [&](auto&& next) {
+    std::vector<std::int32_t> seen(n, -1), uses;
+    if (once) uses.assign(n, 0);
+    for (std::size_t begin = 0, end = 0; next(begin, end);)
+      for (std::size_t v = begin; v < end; ++v) {
+        const auto self = static_cast<std::int32_t>(v);
+        std::int32_t out = g.start[v];
+        const bool has_self =
+            distinct_uses(self, seen, uses, [&](std::int32_t w) { g.item[static_cast<std::size_t>(out++)] = w; });
+        finish(self, g.item.begin() + g.start[v], g.item.begin() + out, has_self, uses);
+      }
+  });
   return g;
 }
 

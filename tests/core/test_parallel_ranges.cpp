@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -47,4 +49,33 @@ TEST_CASE("range_min is the serial minimum; chunk_starts is the serial layout", 
   }
   CHECK(range_min(0, 2, [](std::size_t) { return 1.0; }) == std::numeric_limits<double>::infinity());
   CHECK(chunk_starts(0, 16, 2, std::size_t{3}, [](std::size_t, std::size_t) { return std::size_t{1}; }) == std::vector<std::size_t>{3});
+}
+
+TEST_CASE("for_each_chunk_balanced hands out every chunk once, on every thread count", "[parallel_ranges][threads]") {
+  // Uneven work (the later chunks cost more), per-worker state, and counts with and without a
+  // short last chunk: every index is visited exactly once, and each worker's own state stays its.
+  for (const std::size_t n : {std::size_t(0), std::size_t(1), std::size_t(1000), std::size_t(4096 * 5 + 17)}) {
+    for (const int threads : {1, 2, 3, 8}) {
+      std::vector<int> visits(n, 0);
+      std::atomic<int> workers{0}, bad_chunks{0};  // (Catch's assertions are for the main thread)
+      for_each_chunk_balanced(n, 64, threads, [&](auto&& next) {
+        ++workers;
+        std::vector<std::size_t> mine;  // per-worker state, as the callers' marks
+        for (std::size_t begin = 0, end = 0; next(begin, end);) {
+          if (!(begin < end && end <= n && end - begin <= 64 && begin % 64 == 0)) ++bad_chunks;
+          for (std::size_t i = begin; i < end; ++i) {
+            volatile double x = 0.0;
+            for (std::size_t k = 0; k < i / 64; ++k) x = x + 1.0;
+            mine.push_back(i);
+          }
+        }
+        for (const std::size_t i : mine) ++visits[i];  // distinct indices per worker: no race
+      });
+      CAPTURE(n, threads);
+      CHECK(bad_chunks.load() == 0);
+      CHECK(std::count(visits.begin(), visits.end(), 1) == static_cast<long>(n));
+      CHECK(workers.load() >= 1);
+      CHECK(workers.load() <= std::max(1, threads));
+    }
+  }
 }
