@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/spill_buffer.hpp"
 
 namespace febemesh {
@@ -207,9 +208,16 @@ template <class Format> void parallel_lines(Sink& out, std::size_t count, int n_
   if (error) std::rethrow_exception(error);
 }
 
-template <int Dim> void bbox_line(Sink& out, const Mesh<Dim>& mesh, const Elements& els) {
+template <int Dim> void bbox_line(Sink& out, const Mesh<Dim>& mesh, const Elements& els, int n_threads) {
+  // Per-range boxes merged: minima and maxima are exact in any order (serial, with the node
+  // tags' texts, 0.07 s of the flange's 5.4 M-triangle write on two threads).
+  const std::size_t chunk = chunk_size(els.node.size(), n_threads, std::size_t(1) << 16);
+  std::vector<Box<Dim>> part((els.node.size() + chunk - 1) / chunk, Box<Dim>::empty());
+  for_each_chunk(els.node.size(), chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) part[c].expand(mesh.points[els.node[i].v]);
+  });
   Box<Dim> b = Box<Dim>::empty();
-  for (const VertexId v : els.node) b.expand(mesh.points[v.v]);
+  for (const Box<Dim>& p : part) b.expand(p.lo), b.expand(p.hi);  // (each chunk holds a node)
   if (els.node.empty()) b = Box<Dim>{};
   for (const auto* corner : {&b.lo, &b.hi})
     for (int d = 0; d < 3; ++d) out.f64(d < Dim ? (*corner)[d] : 0.0);
@@ -278,17 +286,20 @@ class TagCounter {
 /// 172k nodes). Empty (decimal() then) above 9,999,999 nodes.
 class NodeTagTexts {
  public:
-  explicit NodeTagTexts(std::size_t n) {
+  NodeTagTexts(std::size_t n, int n_threads) {
     if (n > 9'999'999) return;
     text_.resize(n);
-    TagCounter counter;
-    for (std::size_t i = 0; i < n; ++i) {
-      char buf[32] = {};
-      const auto len = static_cast<std::uint64_t>(counter.put(buf, i + 1) - buf);
-      std::uint64_t w = 0;
-      std::memcpy(&w, buf, 7);
-      text_[i] = w | (len << 56);
-    }
+    // A counter a range: it starts from its range's first tag (the same texts).
+    for_each_range(n, n_threads, [&](std::size_t begin, std::size_t end) {
+      TagCounter counter;
+      for (std::size_t i = begin; i < end; ++i) {
+        char buf[32] = {};
+        const auto len = static_cast<std::uint64_t>(counter.put(buf, i + 1) - buf);
+        std::uint64_t w = 0;
+        std::memcpy(&w, buf, 7);
+        text_[i] = w | (len << 56);
+      }
+    });
   }
   /// Writes the text of node tag `tag` (1-based) at p, which has room for 8 bytes; returns the end.
   char* put(char* p, std::uint64_t tag) const {
@@ -375,13 +386,13 @@ template <int Dim> void write(Sink& out, const Mesh<Dim>& mesh, int n_threads) {
   for (int d = 0; d < 4; ++d) out.size(d == Dim - 1 || d == Dim ? 1 : 0, d == 3 ? '\n' : ' ');
   for (const auto& [els, phys] : {std::pair{&mesh.interface, 2}, std::pair{&mesh.solid, 1}}) {
     out.i32(1);
-    bbox_line<Dim>(out, mesh, *els);
+    bbox_line<Dim>(out, mesh, *els, n_threads);
     out.size(1).i32(phys).size(0, '\n');
   }
   out << end_binary << "$EndEntities\n";
 
   const std::size_t n = mesh.points.size();
-  const NodeTagTexts node_tags(out.binary() ? 0 : n);
+  const NodeTagTexts node_tags(out.binary() ? 0 : n, n_threads);
   out << "$Nodes\n";
   if (n == 0) {
     for (int k = 0; k < 4; ++k) out.size(0, k == 3 ? '\n' : ' ');
