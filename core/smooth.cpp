@@ -328,8 +328,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   }
   struct alignas(64) PerThread {
     std::vector<std::pair<bool, double>> after;
-    std::vector<Point<Dim>> pts;     ///< the tetrahedra's points (all_tets)
-    std::vector<double> jac, sj;     ///< their states (all_tets)
+    std::vector<Point<Dim>> pts;       ///< the tetrahedra's points (all_tets)
+    std::vector<double> jac, sj;       ///< their states (all_tets)
     std::vector<std::int32_t> nbrs;    ///< gathered neighbours (gather)
     std::vector<std::uint8_t> listed;  ///< their marks (gather)
     std::size_t accepted = 0, rejected = 0;
@@ -377,6 +377,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     bool accept = true;
     std::vector<std::pair<bool, double>>& after = my.after;
     after.resize(elems.size());
+    // Accepted iff no valid element inverts and every element stays >= old_min.
     const auto passes = [&](std::size_t k) { return (after[k].first || !valid[elems[k]]) && after[k].second >= old_min; };
     bool lanes = false;
     if constexpr (Dim == 3) lanes = all_tets;
@@ -402,8 +403,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
         }
       }
     } else {
-      // Accepted iff no valid element inverts and every element stays >= old_min: the first
-      // element that fails decides, the element that held old_min (likeliest to drop) first.
+      // The first element that fails decides, the element that held old_min (likeliest to
+      // drop) first.
       for (std::size_t j = 0; j < elems.size() && accept; ++j) {
         const std::size_t k = worst_first(j, worst);
         after[k] = element_state(elems[k]);
