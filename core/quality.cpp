@@ -112,6 +112,18 @@ Point<3> tet_facet_normal(int f, std::span<const Point<3>> p) {
 
 template <int Dim> double tet_signed_measure(std::span<const Point<Dim>> p) {
   if constexpr (Dim == 3) {
+    // The three facets through node 0 add exact zeros below (one of their vectors is
+    // p[0] - p[0]), so only facet {3, 1, 2} counts: the same operations on it give the same
+    // number (the zeros' sums are +0, as 0.0 + w is here), a quarter of the work (this was 4.8%
+    // of sphere966 L6's run on one thread). Not where a product could overflow to infinity
+    // (then 0 * inf is NaN in the loop).
+    const Point<3> a = p[3] - p[0], b = p[1] - p[0], c = p[2] - p[0];
+    const double big = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff()});
+    if (big < 1e100) {
+      double w = 0.0;
+      w += a.dot(b.cross(c));
+      return (0.0 + w) / 6.0;
+    }
     double v = 0.0;
     for (int f = 0; f < 4; ++f) {
       const int* l = tet_facet_nodes[f];

@@ -249,3 +249,38 @@ TEST_CASE("tet_jacobians_n gives jacobians() of each tetrahedron, bit for bit", 
     CHECK(same == count);
   }
 }
+
+TEST_CASE("a tetrahedron's signed volume is its facets' divergence sum, bit for bit", "[quality]") {
+  // The slow twin: the sum over the four facets ({0,2,1}, {0,1,3}, {0,3,2}, {3,1,2}) of
+  // (a - p0) . ((b - p0) x (c - p0)), from 0, over 6; the three through node 0 add zeros.
+  constexpr int facet[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {3, 1, 2}};
+  const auto reference = [&](const std::array<Point<3>, 4>& p) {
+    double v = 0.0;
+    for (const auto& l : facet) {
+      double w = 0.0;
+      w += (p[l[0]] - p[0]).dot((p[l[1]] - p[0]).cross(p[l[2]] - p[0]));
+      v += w;
+    }
+    return v / 6.0;
+  };
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::size_t same = 0, n = 0, nan = 0;
+  for (int i = 0; i < 5000; ++i) {
+    std::array<Point<3>, 4> p;
+    for (auto& x : p) x = Point<3>(u(rng), u(rng), u(rng));
+    if (i % 7 == 0) p[3] = 0.5 * (p[0] + p[1]);           // flat: a zero of either sign
+    if (i % 11 == 0) p[2] = p[1];                         // a zero edge
+    if (i % 13 == 0) p[1][0] = std::nan("");
+    if (i % 17 == 0) for (auto& x : p) x *= 1e-150;       // tiny
+    if (i % 19 == 0) for (auto& x : p) x *= 1e120;        // products overflow: the loop
+    if (i % 23 == 0) p[2][1] = 1e200;                     // one huge coordinate
+    if (i % 29 == 0) p[3] = p[0];                         // node 3 on node 0
+    const double got = signed_measure<3>(ElemType::Tet4, {p.data(), 4});
+    const double want = reference(p);
+    ++n;
+    if (std::isnan(want)) nan += std::isnan(got);
+    else same += std::bit_cast<std::uint64_t>(got) == std::bit_cast<std::uint64_t>(want);
+  }
+  CHECK(same + nan == n);
+}
