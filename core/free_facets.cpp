@@ -122,6 +122,36 @@ void update_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const
   facets = std::move(out);
 }
 
+namespace {
+
+/// The part [t0, t1] of the segment a + t (b - a), t in [0, 1], inside the open box `box`: its
+/// length t1 - t0 as a share of the segment, or a negative number when it misses the box.
+template <int Dim>
+double share_in_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int d = 0; d < Dim; ++d) {
+    const double dir = b[d] - a[d];
+    if (std::abs(dir) < 1e-300) {
+      if (a[d] <= box.lo[d] || a[d] >= box.hi[d]) return -1.0;
+      continue;
+    }
+    double s0 = (box.lo[d] - a[d]) / dir, s1 = (box.hi[d] - a[d]) / dir;
+    if (s0 > s1) std::swap(s0, s1);
+    t0 = std::max(t0, s0);
+    t1 = std::min(t1, s1);
+    if (t0 >= t1) return -1.0;
+  }
+  return t1 - t0;
+}
+
+/// Does the segment meet the open box `box`?
+template <int Dim>
+bool segment_meets_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
+  return share_in_open_box(box, a, b) >= 0.0;
+}
+
+}  // namespace
+
 template <int Dim>
 bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
                          double rel_tol) {
@@ -134,22 +164,37 @@ bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<
     const double shrink = rel_tol * (box.hi[0] - box.lo[0]);
     box.lo.array() += shrink;
     box.hi.array() -= shrink;
-    // Slab clipping of the segment against the shrunk open box.
-    double t0 = 0.0, t1 = 1.0;
-    bool hit = true;
-    for (int d = 0; d < Dim && hit; ++d) {
-      const double dir = b[d] - a[d];
-      if (std::abs(dir) < 1e-300) {
-        if (a[d] <= box.lo[d] || a[d] >= box.hi[d]) hit = false;
-        continue;
-      }
-      double s0 = (box.lo[d] - a[d]) / dir, s1 = (box.hi[d] - a[d]) / dir;
-      if (s0 > s1) std::swap(s0, s1);
-      t0 = std::max(t0, s0);
-      t1 = std::min(t1, s1);
-      if (t0 >= t1) hit = false;
+    if (segment_meets_open_box(box, a, b)) return true;
+  }
+  return false;
+}
+
+template <int Dim>
+bool segment_enters_kept_region(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
+                                double rel_tol, double graze_length) {
+  Box<Dim> sb = Box<Dim>::empty();
+  sb.expand(a);
+  sb.expand(b);
+  std::vector<std::size_t> nb;
+  for (std::size_t i : leaves_in_box(t, sb)) {
+    if (!keep[i]) continue;
+    const Box<Dim> cell = geometry(t, t.leaf(i));
+    const double size = cell.hi[0] - cell.lo[0];
+    Box<Dim> box = cell;
+    box.lo.array() += 1e-9 * size;
+    box.hi.array() -= 1e-9 * size;
+    const double share = share_in_open_box(box, a, b);
+    if (share < 0.0) continue;
+    if (graze_length > 0 && share * (b - a).norm() > graze_length * size) return true;
+    // It grazes the leaf at least: shrink the faces on the region's boundary by the allowance.
+    for (int f = 0; f < Cube<Dim>::n_faces; ++f) {
+      face_neighbours(t, i, f, nb);
+      const bool inner = !nb.empty() && std::all_of(nb.begin(), nb.end(), [&](std::size_t j) { return keep[j] != 0; });
+      if (inner) continue;
+      if (f % 2) box.hi[f / 2] = cell.hi[f / 2] - rel_tol * size;
+      else box.lo[f / 2] = cell.lo[f / 2] + rel_tol * size;
     }
-    if (hit) return true;
+    if (segment_meets_open_box(box, a, b)) return true;
   }
   return false;
 }
@@ -166,5 +211,9 @@ template void update_free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, cons
                                     std::vector<FreeFacet<3>>&);
 template bool segment_enters_kept<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&, double);
 template bool segment_enters_kept<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&, double);
+template bool segment_enters_kept_region<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&,
+                                             double, double);
+template bool segment_enters_kept_region<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&,
+                                             double, double);
 
 }  // namespace febemesh

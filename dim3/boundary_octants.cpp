@@ -307,6 +307,8 @@ struct Projector {
   double min_outward = -1.0;  // BoundaryOctantOptions
   double min_facing = -1.0;
   bool outward_all_faces = false;
+  bool graze_region = false;  // BoundaryOctantOptions::graze_region, graze_length
+  double graze_length = 0.0;
 
   /// The segment from q to a surface point p (on triangle `patch`, -1 = unknown) leaves through
   /// one of q's free faces (`dirs`, bit f = face f) and lands on a side of the surface facing
@@ -314,7 +316,9 @@ struct Projector {
   /// reaching p.
   bool admissible(const P3& q, const P3& p, std::uint8_t dirs = 0, std::int32_t patch = -1) const {
     if (dirs != 0 && !leaves_outward(q, p, dirs, patch)) return false;
-    if (segment_enters_kept(tree, in, q, p, graze)) return false;
+    const bool enters = graze_region ? segment_enters_kept_region(tree, in, q, p, graze, graze_length)
+                                     : segment_enters_kept(tree, in, q, p, graze);
+    if (enters) return false;
     return !surface.crosses_before(q, p);
   }
   /// Some free face f of q has cos(p - q, n_f) >= min_outward and cos(n_p, n_f) >= min_facing:
@@ -731,7 +735,8 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
-  Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing, opt.outward_all_faces};
+  Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing, opt.outward_all_faces, opt.graze_region,
+                 opt.graze_length};
   // Each node's projection depends on the node alone: found on opt.n_threads threads, then
   // counted, shared and numbered in node order (the same nodes for every thread count).
   enum class How : std::uint8_t { none, closest, next_normal, ray, blind, problem };

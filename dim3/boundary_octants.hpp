@@ -119,6 +119,12 @@ struct BoundaryOctantOptions {
   int max_normals = 4;               ///< local minima tried per node
   bool blind_closest = true;         ///< no admissible point: keep the closest one, not a Problem
   double graze = 0.05;               ///< a projection segment may cut this fraction of an interior octant's size
+  /// The graze allowance only at the interior region's boundary (segment_enters_kept_region):
+  /// a segment along a face between two interior octants is refused.
+  bool graze_region = false;
+  /// With graze_region: a segment running along an interior octant for more than this x its
+  /// size enters it (0 = off; segment_enters_kept_region's graze_length).
+  double graze_length = 0.0;
   /// A projection must leave its node through one of the node's free faces: the cosine between
   /// the segment and that face's outward normal at least min_outward, and the cosine between the
   /// surface normal where it lands and that face's normal at least min_facing (-1 = no such

@@ -147,8 +147,8 @@ int count_bad(const Mesh<3>& m, const std::vector<std::size_t>& elems, std::int3
 /// projection, which unfolds crossed projections), halfway there, or the first surface point
 /// along the mean outward normal of their free faces. Every candidate must stay admissible from
 /// all the face nodes projecting onto it. Returns how many nodes moved.
-std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, OctantComplex& oc,
-                     TetMesh& fe) {
+std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, bool graze_region,
+                     double graze_length, OctantComplex& oc, TetMesh& fe) {
   const std::int32_t n_lat = oc.n_lattice(), n_pts = static_cast<std::int32_t>(oc.points.size());
   Mesh<3>& m = fe.mesh;
   const std::vector<std::size_t> bad = inverted_elements(m);
@@ -183,7 +183,9 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
   const auto admissible = [&](std::int32_t p, const P3& x) {
     for (std::int32_t q : sources[p]) {
       const P3& from = oc.points[q];
-      if (segment_enters_kept(t, in, from, x, graze)) return false;
+      const bool enters = graze_region ? segment_enters_kept_region(t, in, from, x, graze, graze_length)
+                                       : segment_enters_kept(t, in, from, x, graze);
+      if (enters) return false;
       if (s.crosses_before(from, x)) return false;
     }
     return true;
@@ -874,6 +876,8 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     BoundaryOctantOptions bo;
     bo.snap_features = opt.snap_features;
     bo.graze = opt.graze;
+    bo.graze_region = opt.graze_region;
+    bo.graze_length = opt.graze_length;
     bo.min_outward = opt.min_outward;
     bo.min_facing = opt.min_facing;
     bo.outward_all_faces = opt.outward_all_faces;
@@ -919,7 +923,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         for (std::size_t f : folded) revert_snapped(fe.mesh.interface, f);
         if (bad.empty() && folded.empty()) break;
         if (revert.empty()) {
-          const std::size_t moved = round < opt.untangle_rounds + 4 ? untangle(tree, in, s, opt.graze, oc.complex, fe) : 0;
+          const std::size_t moved =
+              round < opt.untangle_rounds + 4
+                  ? untangle(tree, in, s, opt.graze, opt.graze_region, opt.graze_length, oc.complex, fe)
+                  : 0;
           r.n_untangled += moved;
           if (moved == 0) {
             // Last resort on this tree: where no node move raises the worst tetrahedron, the

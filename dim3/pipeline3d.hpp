@@ -64,6 +64,12 @@ struct Options3d {
   /// min_facing 0.3, outward_all_faces) and accept_valid_folds (Result3d::facing_projection).
   bool retry_facing = true;
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
+  /// BoundaryOctantOptions::graze_region and graze_length, for the untangling's moves too. Off:
+  /// no try sets them (measured on rotor's sampled thickness try, docs/measurements.md, branch
+  /// rotor3: graze_region took its last places from 9 in three spots to 6-10 at the rim's edge;
+  /// graze_length 0.5 on top of it doubled the first tree's problems).
+  bool graze_region = false;
+  double graze_length = 0.0;
   /// Projection admissibility (BoundaryOctantOptions min_outward, min_facing, outward_all_faces).
   double min_outward = -1.0;
   double min_facing = -1.0;

@@ -184,8 +184,8 @@ Box<3> SurfaceBoundary::root_box() const {
   const Box<3> b = surface_.bounding_box();
   const double half = 0.5 * 1.05 * b.extent().maxCoeff();
   Box<3> cube;
-  cube.lo = b.center().array() - half;
-  cube.hi = b.center().array() + half;
+  cube.lo = b.center().array() - half + 2.0 * half * options_.root_shift.array();
+  cube.hi = b.center().array() + half + 2.0 * half * options_.root_shift.array();
   return cube;
 }
 

@@ -51,6 +51,11 @@ struct SurfaceOptions {
   /// outer wall, a 27-degree chord of its cylinder over the inner one: 0.0034 thick where the
   /// four rays see 0.0081) gets the finer level there and nowhere else.
   bool thickness_sampled = false;
+  /// The root cube's shift from its centred place, in shares of its side per axis (0: the
+  /// bounding box's centre). A face of the surface parallel to a lattice plane and just outside
+  /// it makes flat boundary octants on it (rotor.off's rim, 0.05 of a level-8 octant above
+  /// one); a shift moves every lattice plane against the surface.
+  P3 root_shift = P3::Zero();
 };
 
 class SurfaceBoundary final : public Boundary<3> {
@@ -86,8 +91,12 @@ class SurfaceBoundary final : public Boundary<3> {
   double area() const { return surface_.area(); }
   const Features& features() const { return features_; }
   const AabbTree& tree() const { return tree_; }
-  /// Smallest cube around the bounding box, enlarged by 5%, same centre.
+  /// Smallest cube around the bounding box, enlarged by 5%, same centre, shifted by
+  /// SurfaceOptions::root_shift.
   Box<3> root_box() const;
+  /// SurfaceOptions::root_shift; the trees built after it use the moved lattice.
+  void set_root_shift(const P3& shift) { options_.root_shift = shift; }
+  const P3& root_shift() const { return options_.root_shift; }
 
   void set_global_level(double level) { options_.global_level = level; }
   void set_max_level(double level) { options_.max_level = level; }

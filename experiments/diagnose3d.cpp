@@ -27,6 +27,9 @@
 // facing projections, level raise, thickness retry); --nosnap: no feature snapping there;
 // --feature-extra L: SurfaceOptions::feature_extra_levels (default 1), the level field's
 // feature level above the global one; --near X Y Z R with --dump: only octants near a point.
+// --root-shift X Y Z: SurfaceOptions::root_shift (the lattice moved against the surface).
+// --graze-region: BoundaryOctantOptions::graze_region (and Options3d's, for the untangling):
+// the graze allowance only at the interior region's boundary; --graze-length L its graze_length.
 // --sampled: SurfaceOptions::thickness_sampled (the thickness level from a grid of rays per
 // triangle). Environment, first tree: FEBEMESH_DUMP_CELLS=1 with --near lists the leaves there
 // (level, side, kept, dropped as a pinch or an island); FEBEMESH_DUMP_DROPPED=1 lists every leaf
@@ -195,12 +198,16 @@ constexpr const char* usage =
     "  --near X Y Z R        with --dump: only octants within R of (X, Y, Z)\n"
     "  --snap                snap to feature lines here too      --unfold   unfold backward projections\n"
     "  --all                 outward test on all faces           --norays   no projection rays\n"
+    "  --graze-region        the graze allowance at the interior region's boundary only\n"
+    "  --graze-length L      with --graze-region: a segment along an interior octant for more\n"
+    "                        than L x its size enters it\n"
     "  --outward C           BoundaryOctantOptions::min_outward  --facing C  min_facing\n"
     "  --feature-extra L     the feature level above the global one (default 1)\n"
     "  --feature-at-edges    the feature level at the feature edges only\n"
     "  --sampled             SurfaceOptions::thickness_sampled (the thickness level from a grid of rays)\n"
     "  --opposing            drop interior octants at nodes with opposing free faces\n"
     "  --thin-share          print the share of the surface thinner than 0.5-2 octants, and stop\n"
+    "  --root-shift X Y Z    SurfaceOptions::root_shift (the root cube moved by these shares of its side)\n"
     "whole pipeline:\n"
     "  --pipeline            run mesh3d and print its verdict, tets, min dihedral, volume error\n"
     "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin;\n"
@@ -221,7 +228,8 @@ int option_values(const std::string& a) {
       {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
-      {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1}};
+      {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1},
+      {"--graze-region", 0}, {"--graze-length", 1}, {"--root-shift", 3}};
   for (const auto& [name, n] : known)
     if (a == name) return n;
   return -1;
@@ -263,6 +271,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--feature-at-edges") so.feature_level_at_edges = true;
     if (std::string(argv[i]) == "--sampled") so.thickness_sampled = true;
+    if (std::string(argv[i]) == "--root-shift" && i + 3 < argc)
+      so.root_shift = P3(std::atof(argv[i + 1]), std::atof(argv[i + 2]), std::atof(argv[i + 3]));
   }
   int dump = 0, only = -1;
   bool near_on = false;
@@ -274,6 +284,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--all") bo.outward_all_faces = true;
     if (std::string(argv[i]) == "--norays") bo.rays = false;
     if (std::string(argv[i]) == "--unfold") bo.unfold_backward = true;
+    if (std::string(argv[i]) == "--graze-region") bo.graze_region = true;
     if (std::string(argv[i]) == "--snap") bo.snap_features = true;
     if (std::string(argv[i]) == "--near" && i + 4 < argc) {
       near_on = true;
@@ -283,6 +294,7 @@ int main(int argc, char** argv) {
     if (i + 1 >= argc) continue;
     if (std::string(argv[i]) == "--outward") bo.min_outward = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--facing") bo.min_facing = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--graze-length") bo.graze_length = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--dump") dump = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--only") only = std::atoi(argv[i + 1]);
   }
@@ -295,6 +307,8 @@ int main(int argc, char** argv) {
   opt.outward_all_faces = bo.outward_all_faces;
   opt.projection_rays = bo.rays;
   opt.unfold_backward = bo.unfold_backward;
+  opt.graze_region = bo.graze_region;
+  opt.graze_length = bo.graze_length;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--accept-folds") opt.accept_valid_folds = true;
   for (int i = 1; i + 1 < argc; ++i) {

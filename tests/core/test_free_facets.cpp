@@ -68,3 +68,34 @@ TEMPLATE_TEST_CASE_SIG("free_facets skips only facets with kept leaves across", 
     RC_ASSERT(same<Dim>(free_facets(t, keys, keep), searched));
   });
 }
+
+TEMPLATE_TEST_CASE_SIG("segment_enters_kept_region: the graze allowance only at the region's boundary", "[free_facets]",
+                       ((int Dim), Dim), 2, 3) {
+  // The unit cube in 4^Dim leaves of size 0.25, the lower half along axis 0 kept (x < 0.5).
+  Orthtree<Dim> t;
+  for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
+  Flags keep(t.n_leaves());
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
+  // Along the plane x = 0.25 between two kept leaves, 0.01 (0.04 of a leaf) off it: the face
+  // is inside the region, so the segment enters it; each leaf alone is only grazed.
+  a[0] = b[0] = 0.26;
+  a[1] = 0.05;
+  b[1] = 0.95;
+  CHECK_FALSE(segment_enters_kept(t, keep, a, b, 0.05));
+  CHECK(segment_enters_kept_region(t, keep, a, b, 0.05));
+  // Along the region's boundary x = 0.5, 0.01 inside: grazing, allowed by both; but it runs
+  // along the leaves for more than half their size (graze_length 0.5).
+  a[0] = b[0] = 0.49;
+  CHECK_FALSE(segment_enters_kept(t, keep, a, b, 0.05));
+  CHECK_FALSE(segment_enters_kept_region(t, keep, a, b, 0.05));
+  CHECK(segment_enters_kept_region(t, keep, a, b, 0.05, 0.5));
+  // Out of the region from 0.01 inside it: a short graze, allowed.
+  Point<Dim> c = a;
+  c[0] = 0.8;
+  CHECK_FALSE(segment_enters_kept_region(t, keep, a, c, 0.05, 0.5));
+  // Deeper than the allowance: refused by both.
+  a[0] = b[0] = 0.4;
+  CHECK(segment_enters_kept(t, keep, a, b, 0.05));
+  CHECK(segment_enters_kept_region(t, keep, a, b, 0.05));
+}
