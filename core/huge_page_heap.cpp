@@ -1,7 +1,6 @@
 #include "core/huge_page_heap.hpp"
 
 #include <cstdlib>  // defines __GLIBC__ on glibc
-#include <cstring>
 #include <fstream>
 
 #if defined(__GLIBC__)
@@ -9,6 +8,8 @@
 #endif
 #include <sys/auxv.h>
 #include <unistd.h>
+
+#include "core/huge_pages.hpp"
 
 #if __has_include(<valgrind/valgrind.h>)
 #include <valgrind/valgrind.h>
@@ -84,8 +85,7 @@ void reexec_with_huge_page_heap(char** argv) {
 
 void set_up_heap(char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
-  const char* huge = std::getenv("FEBEMESH_HUGE_PAGES");
-  if (huge && std::strcmp(huge, "1") == 0) reexec_with_huge_page_heap(argv);
+  if (huge_pages_wanted()) reexec_with_huge_page_heap(argv);
   if (!tunable_is_set(std::getenv("GLIBC_TUNABLES"), "glibc.malloc.arena_max")) mallopt(M_ARENA_MAX, 1);
 #else
   (void)argv;
