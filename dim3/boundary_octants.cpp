@@ -257,6 +257,11 @@ std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep)
   return removed;
 }
 
+bool enters_interior(const Orthtree<3>& t, const Flags& in, const P3& a, const P3& b, double graze, bool graze_region,
+                     double graze_length) {
+  return graze_region ? segment_enters_kept_region(t, in, a, b, graze, graze_length) : segment_enters_kept(t, in, a, b, graze);
+}
+
 std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, double fraction, int n_threads,
                          bool whole_face) {
   if (fraction <= 0) return 0;
@@ -316,9 +321,7 @@ struct Projector {
   /// reaching p.
   bool admissible(const P3& q, const P3& p, std::uint8_t dirs = 0, std::int32_t patch = -1) const {
     if (dirs != 0 && !leaves_outward(q, p, dirs, patch)) return false;
-    const bool enters = graze_region ? segment_enters_kept_region(tree, in, q, p, graze, graze_length)
-                                     : segment_enters_kept(tree, in, q, p, graze);
-    if (enters) return false;
+    if (enters_interior(tree, in, q, p, graze, graze_region, graze_length)) return false;
     return !surface.crosses_before(q, p);
   }
   /// Some free face f of q has cos(p - q, n_f) >= min_outward and cos(n_p, n_f) >= min_facing:

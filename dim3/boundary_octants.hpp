@@ -108,6 +108,13 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
 /// octants were dropped.
 std::size_t keep_largest_components(const Orthtree<3>& t, Flags& in, int n_keep);
 
+/// Whether the segment a -> b enters the interior octants `in` by more than the graze allowance
+/// (BoundaryOctantOptions::graze, graze_region, graze_length): segment_enters_kept_region with
+/// graze_region, else segment_enters_kept. The boundary octants' projections and the
+/// untangling's moves both ask it.
+bool enters_interior(const Orthtree<3>& t, const Flags& in, const P3& a, const P3& b, double graze, bool graze_region,
+                     double graze_length);
+
 /// Drop interior octants whose free faces come nearer the surface than `fraction` of their size.
 /// The facets' distances on n_threads threads (the same octants dropped for any count).
 /// With `whole_face`, only those whose free face lies that near the surface at all its corners

@@ -183,9 +183,7 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
   const auto admissible = [&](std::int32_t p, const P3& x) {
     for (std::int32_t q : sources[p]) {
       const P3& from = oc.points[q];
-      const bool enters = graze_region ? segment_enters_kept_region(t, in, from, x, graze, graze_length)
-                                       : segment_enters_kept(t, in, from, x, graze);
-      if (enters) return false;
+      if (enters_interior(t, in, from, x, graze, graze_region, graze_length)) return false;
       if (s.crosses_before(from, x)) return false;
     }
     return true;
