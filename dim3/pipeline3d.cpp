@@ -479,6 +479,12 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 }  // namespace
 
+std::size_t apply_buffer_rules(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, const Options3d& opt) {
+  std::size_t n = apply_buffer(t, in, s, opt.buffer, opt.n_threads);
+  if (opt.flat_buffer > opt.buffer) n += apply_buffer(t, in, s, opt.flat_buffer, opt.n_threads, true);
+  return n;
+}
+
 Options3d facing_try_options(const Options3d& opt) {
   Options3d facing = opt;
   facing.buffer = 0.0;
@@ -774,8 +780,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     say("interior octants: classifying " + std::to_string(tree.n_leaves()) + " octants");
     const std::vector<Side> sides = classify(tree, s, opt.n_threads);
     Flags in = interior_flags(sides);
-    r.n_buffer_dropped = apply_buffer(tree, in, s, opt.buffer, opt.n_threads);
-    if (opt.flat_buffer > opt.buffer) r.n_buffer_dropped += apply_buffer(tree, in, s, opt.flat_buffer, opt.n_threads, true);
+    r.n_buffer_dropped = apply_buffer_rules(tree, in, s, opt);
     r.n_peeled = peel(tree, in, peel_points);
     r.n_pinches_dropped = remove_pinches(tree, in);
     r.n_opposing_dropped = 0;

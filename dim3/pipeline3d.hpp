@@ -215,6 +215,10 @@ using Progress3 = std::function<void(const std::string&)>;
 /// when those are refused cheaply, all of it one level finer (Options3d::raise_levels).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
+/// The buffer rules of opt on the interior octants `in`: Options3d::buffer, then flat_buffer
+/// where it reaches farther (apply_buffer's whole faces). Returns how many octants they dropped.
+std::size_t apply_buffer_rules(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, const Options3d& opt);
+
 /// The options of mesh3d's last try when every other fails (Options3d::retry_facing): `opt`
 /// without the buffer rule, with facing projections only, accept_valid_folds, one repair that
 /// makes things worse allowed, and no further retry.

@@ -387,8 +387,7 @@ int main(int argc, char** argv) {
   Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
   const std::vector<Side> sides = classify(tree, s);
   Flags in = interior_flags(sides);
-  std::size_t nb = apply_buffer(tree, in, s, opt.buffer);
-  if (opt.flat_buffer > opt.buffer) nb += apply_buffer(tree, in, s, opt.flat_buffer, 1, true);
+  const std::size_t nb = apply_buffer_rules(tree, in, s, opt);
   const Flags before_pinches = in;
   std::size_t np = remove_pinches(tree, in);
   std::size_t n_opposing = 0;
