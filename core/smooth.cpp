@@ -379,36 +379,32 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     after.resize(elems.size());
     // Accepted iff no valid element inverts and every element stays >= old_min.
     const auto passes = [&](std::size_t k) { return (after[k].first || !valid[elems[k]]) && after[k].second >= old_min; };
-    bool lanes = false;
-    if constexpr (Dim == 3) lanes = all_tets;
-    if (lanes) {
-      // The worst alone first (most rejections stop there), then all of them four at a time:
-      // the same states, and the same verdict (every element must pass either way).
-      after[worst] = element_state(elems[worst]);
-      accept = passes(worst);
-      if constexpr (Dim == 3) {
-        if (accept && elems.size() > 1) {
-          my.pts.resize(4 * elems.size());
-          my.jac.resize(elems.size());
-          my.sj.resize(elems.size());
-          for (std::size_t k = 0; k < elems.size(); ++k) {
-            const VertexId* ev = mesh.solid.nodes(ElemId{elems[k]});
-            for (int i = 0; i < 4; ++i) my.pts[4 * k + i] = mesh.points[ev[i].v];
-          }
-          tet_jacobians_n(my.pts.data(), elems.size(), my.jac.data(), my.sj.data());
-          for (std::size_t k = 0; k < elems.size() && accept; ++k) {
-            after[k] = {my.jac[k] > 0.0, my.sj[k]};
-            accept = passes(k);
-          }
-        }
-      }
-    } else {
+    if (!all_tets) {
       // The first element that fails decides, the element that held old_min (likeliest to
       // drop) first.
       for (std::size_t j = 0; j < elems.size() && accept; ++j) {
         const std::size_t k = worst_first(j, worst);
         after[k] = element_state(elems[k]);
         accept = passes(k);
+      }
+    } else if constexpr (Dim == 3) {  // (all_tets is false in 2D)
+      // The worst alone first (most rejections stop there), then all of them four at a time:
+      // the same states, and the same verdict (every element must pass either way).
+      after[worst] = element_state(elems[worst]);
+      accept = passes(worst);
+      if (accept && elems.size() > 1) {
+        my.pts.resize(4 * elems.size());
+        my.jac.resize(elems.size());
+        my.sj.resize(elems.size());
+        for (std::size_t k = 0; k < elems.size(); ++k) {
+          const VertexId* ev = mesh.solid.nodes(ElemId{elems[k]});
+          for (int i = 0; i < 4; ++i) my.pts[4 * k + i] = mesh.points[ev[i].v];
+        }
+        tet_jacobians_n(my.pts.data(), elems.size(), my.jac.data(), my.sj.data());
+        for (std::size_t k = 0; k < elems.size() && accept; ++k) {
+          after[k] = {my.jac[k] > 0.0, my.sj[k]};
+          accept = passes(k);
+        }
       }
     }
     if (accept) {
