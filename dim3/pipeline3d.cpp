@@ -394,6 +394,108 @@ struct Effort {
 
 Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress);
 
+/// The quality stage, on a mesh whose tetrahedra are all positive: guarded Laplacian
+/// smoothing, the dihedral-angle sweeps and edge removal (what each step gained: the comments
+/// at its options). Its counts go to r. A tetrahedral run frees the complex but its snap marks.
+void improve_quality(const SurfaceBoundary& s, OctantComplex& complex, TetMesh& fe, const Options3d& opt,
+                     const SurfacePointFn& surface_point, const std::function<P3(const BoundaryLocation&)>& surface_normal,
+                     Result3d& r, const Progress3& say) {
+  // From here on a tetrahedral mesh needs only the complex's snap marks (which nodes the
+  // sweeps keep fixed or slide along a line); the hex-dominant merge needs all of it.
+  if (!opt.hex_dominant) keep_snap_marks_only(complex);
+  say("smoothing: " + std::to_string(opt.smoothing_iterations) + " guarded Laplacian iterations");
+  SmoothOptions<3> so;
+  so.n_iterations = opt.smoothing_iterations;
+  so.n_threads = opt.n_threads;
+  so.fixed.assign(fe.mesh.points.size(), 0);
+  for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
+  so.boundary_fixed = true;  // the solid's boundary is the surface faces, all of whose nodes are on it
+  const SmoothStats ss = smooth(fe.mesh, so);
+  r.n_smoothing_accepted = ss.moves_accepted;
+  r.n_smoothing_rejected = ss.moves_rejected;
+  if (opt.optimize_sweeps > 0) {
+    // Sliver removal: raise each node's worst dihedral angle (surface nodes slide on the
+    // surface; feature nodes stay on their features).
+    TetOptimizeOptions to;
+    to.max_sweeps = opt.optimize_sweeps;
+    to.target_dihedral_deg = opt.target_dihedral_deg;
+    to.fixed = fixed_nodes(complex, fe, true);
+    to.project = surface_point;
+    to.surface_normal = surface_normal;
+    to.n_threads = opt.n_threads;
+    // The ranks go from each pass to the next (the points do not move in between).
+    std::vector<double> ranks;
+    to.ranks = &ranks;
+    const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
+    r.n_optimize_moves = ts.moves;
+    if (opt.slide_feature_nodes && slide_on_lines(s, complex, fe, to) > 0) {
+      // More passes with the feature-line nodes sliding along their lines. After the first
+      // pass, not in it: sliding from the start changes every later move and ended worse
+      // on spool L4 (9.55 deg) and fandisk L4 (11.62). No pass can lower the minimum (every
+      // move raises its node's worst tetrahedron); each starts afresh from every node below
+      // the target. Measured (CLI, L4, min dihedral deg, anchor/spool/fandisk): one pass
+      // 8.73/10.24/12.21; + one sliding 11.46/13.08/13.17 (+ one with the lines fixed
+      // instead: 9.49/12.66/13.18); + two sliding 11.55/14.33/13.18; + two sliding and one
+      // with the crease moves below 20 deg (tangent_below_deg) 12.84/14.33/13.18 (that one
+      // as the only extra pass: 12.72/11.79/13.18). Those passes aim at 20 deg, not the
+      // first pass's 30: 12.73/14.30/13.18 instead of 12.84/14.33/13.18, in 14.5/4.6/16.0 s
+      // CPU instead of 24.5/9.7/17.5 (one pass: 13.0/4.1/14.4).
+      to.target_dihedral_deg = std::min(opt.target_dihedral_deg, 20.0);
+      for (int pass = 0; pass < 3; ++pass) {
+        if (pass == 2) to.tangent_below_deg = 20.0;
+        r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
+      }
+    }
+    if (opt.remove_edges_below_deg > 0) {
+      // Node moves stall where the connectivity fixes a wedge (anchor L5: four tetrahedra
+      // around a surface edge whose triangles meet at 62 deg, five under 10 deg). Measured
+      // (CLI, min dihedral deg, base -> edges under 15 deg -> under 30): anchor L5 9.45 ->
+      // 12.20 -> 14.38; L4: sphere966 28.17 -> 28.17 -> 29.93, spool 14.30 (unchanged),
+      // anchor 12.73 -> 16.70 -> 19.56 (25 deg: 19.96, anchor L5 12.81), fandisk 13.18 ->
+      // 14.33 -> 14.34, rotor 16.73 -> 16.73 -> 17.60, elephant 13.80 -> 16.78 (one round) ->
+      // 21.42. Volume and Hausdorff errors the same to 3 digits; CPU about the same (30 deg
+      // with a sort per removal instead of a heap: anchor L5 14.3 s instead of 6.5).
+      EdgeRemovalOptions eo;
+      eo.below_deg = opt.remove_edges_below_deg;
+      // A hex-dominant mesh loses every hex and pyramid of a cell whose tetrahedra change:
+      // there only the tetrahedra under the merge's own bar (sphere966 L4 at 30 deg: hex
+      // volume share 0.999 -> 0.459).
+      if (opt.hex_dominant) eo.below_deg = std::min(eo.below_deg, opt.hex.min_dihedral_deg);
+      eo.surface_normal = surface_normal;
+      eo.n_threads = opt.n_threads;
+      eo.contract_below_deg = opt.contract_edges_below_deg;
+      eo.ranks = &ranks;
+      // Contractions keep the corners. Nodes snapped onto a feature line may go (into a node
+      // of theirs): those the sweeps keep fixed include some whose closest point is on a
+      // face beside the line (fandisk L5: the smooth-surface end of a 0.0012 edge whose
+      // seven tetrahedra stayed under 15 deg).
+      std::vector<std::uint8_t> corners = fixed_nodes(complex, fe, false);
+      for (int round = 0; round < 3; ++round) {
+        eo.keep = corners;
+        const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
+        r.n_edges_removed += es.removed;
+        r.n_edges_contracted += es.contracted;
+        r.n_concave_swaps += es.concave_swapped;
+        for (auto* per_node : {&corners, &to.fixed, &to.on_line}) remap_nodes(es.node_map, *per_node);
+        remap_nodes(es.node_map, fe.where);
+        if (!es.node_map.empty()) {  // the template's node ids -> today's (make_hex_dominant)
+          if (fe.node_map.empty()) fe.node_map = es.node_map;
+          else
+            for (std::int32_t& id : fe.node_map)
+              if (id >= 0) id = es.node_map[static_cast<std::size_t>(id)];
+        }
+        // With --elements hex those cells stay tetrahedra (make_hex_dominant).
+        std::vector<std::int32_t> changed;
+        std::set_union(fe.cells_changed.begin(), fe.cells_changed.end(), es.cells_changed.begin(),
+                       es.cells_changed.end(), std::back_inserter(changed));
+        fe.cells_changed = std::move(changed);
+        if (es.removed == 0 && es.contracted == 0) break;
+        r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
+      }
+    }
+  }
+}
+
 /// Volume of the leaves kept `before` keep_largest_components and dropped by it (`after`).
 double island_volume(const Orthtree<3>& t, const Flags& before, const Flags& after) {
   double v = 0.0;
@@ -739,11 +841,16 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     OctantComplexResult oc;
     TetMesh fe;
     bool topology_right = true;  ///< false: its Euler characteristic is wrong (not a valid mesh)
+    bool smoothed = true;        ///< false: saved before the quality stage (a wrong topology)
   };
   std::optional<Saved> saved;  // the last mesh whose topology or islands a refinement tries to fix
   // The valid coarser mesh in `saved` stands (with its volume warning) when the finer tree's
   // cannot be built.
   const auto restore_saved = [&]() {
+    if (!saved->smoothed) {
+      improve_quality(s, saved->oc.complex, saved->fe, opt, surface_point, surface_normal, saved->r, say);
+      clock.lap("smoothing");
+    }
     std::vector<StageTime3> times = std::move(r.times);
     r = std::move(saved->r);
     r.times = std::move(times);
@@ -899,6 +1006,46 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     // Set when the untangling left folded interface triangles but no inverted tetrahedron and
     // opt.accept_valid_folds: the folds, refined around unless the smoothed mesh validates.
     std::optional<std::vector<Problem3>> folds_pending;
+    // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the
+    // solid's Euler characteristic is not half the surface's): refine the octants the surface
+    // crosses once more and rebuild, rather than keep a mesh that misses them. `smoothed`: the
+    // quality stage has run (islands are looked at only then: that mesh may stand, the saved
+    // one); `euler`: the mesh's Euler characteristic, when looked at. True when the tree was
+    // refined.
+    // Whether the mesh passes the validator's checks without the surface's (on all threads: the
+    // same answer).
+    const auto validates = [&](const Mesh<3>& m) {
+      ValidateOptions<3> vo;
+      vo.n_threads = opt.n_threads;
+      return validate(m, vo).valid;
+    };
+    const auto refine_surface_octants = [&](bool smoothed, std::optional<long> euler) {
+      const bool topology_wrong = euler && s.euler_characteristic() % 2 == 0 && *euler != s.euler_characteristic() / 2;
+      // Not for islands alone where the island trial showed that one level more does not
+      // resolve them: refining every octant on the surface is that refinement and more (rotor
+      // L5: 14125 octants refined, then 678 -> 338 -> 736 -> 439 problems over the repairs, the
+      // valid mesh before it standing in the end, minutes of CPU later).
+      const bool islands_unresolvable = island_trial_reverted && !topology_wrong;
+      if (!((topology_wrong || (smoothed && r.n_islands_dropped > 0)) && !islands_unresolvable)) return false;
+      Flags flags(tree.n_leaves(), 0);
+      std::size_t n_marked = 0;
+      for (std::size_t i = 0; i < tree.n_leaves(); ++i)
+        if (sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+      if (n_marked == 0) return false;
+      ++topology_refinements;
+      ++r.n_repairs;
+      say("repair " + std::to_string(attempt + 1) + ": refining the " + std::to_string(n_marked) +
+          " octants on the surface (" +
+          (topology_wrong ? "Euler characteristic " + std::to_string(*euler) + ", expected " +
+                                std::to_string(s.euler_characteristic() / 2)
+                          : std::to_string(r.n_islands_dropped) + " octants in islands") +
+          ")");
+      saved = Saved{r, tree, in, oc, std::move(fe), !topology_wrong, smoothed};
+      n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
+      tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
+      clock.lap("repair refinement");
+      return true;
+    };
     if (problems.empty()) {
       say("finite elements: templates");
       // Feature snaps that invert an element are undone, then the templates are redone.
@@ -970,101 +1117,24 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       }
       clock.lap("templates");
     }
+    // A wrong Euler characteristic sends the tree to that refinement whatever the quality stage
+    // does, and the stage keeps it (no move inverts a tetrahedron; edge removal and contraction
+    // keep the links): so it is looked at before the stage, which then runs on the finer tree
+    // only. Not where the validator decides on this tree's folds after the stage; a mesh the
+    // Escobar pass made positive goes to that refinement only if it conforms (else its problems
+    // are refined around, below). Measured (CLI, one thread, user s; the same mesh.msh on all 12
+    // level-4 runs and the 6 level-5 tetrahedral ones): elephant L4 38.1 -> 31.7 (peak 280 ->
+    // 265 MB), anchor L4 7.8 -> 6.9.
+    bool topology_right = false;  // known to be
+    if (problems.empty() && !folds_pending && topology_refinements < opt.topology_refinements && !last) {
+      const long euler = euler_characteristic<3>(fe.mesh, opt.n_threads);
+      topology_right = s.euler_characteristic() % 2 != 0 || euler == s.euler_characteristic() / 2;
+      if (!topology_right && (!before_escobar || validates(fe.mesh)) &&
+          refine_surface_octants(false, euler))
+        continue;
+    }
     if (problems.empty()) {
-      // From here on a tetrahedral mesh needs only the complex's snap marks (which nodes the
-      // sweeps keep fixed or slide along a line); the hex-dominant merge needs all of it.
-      if (!opt.hex_dominant) keep_snap_marks_only(oc.complex);
-      say("smoothing: " + std::to_string(opt.smoothing_iterations) + " guarded Laplacian iterations");
-      SmoothOptions<3> so;
-      so.n_iterations = opt.smoothing_iterations;
-      so.n_threads = opt.n_threads;
-      so.fixed.assign(fe.mesh.points.size(), 0);
-      for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
-      so.boundary_fixed = true;  // the solid's boundary is the surface faces, all of whose nodes are on it
-      const SmoothStats ss = smooth(fe.mesh, so);
-      r.n_smoothing_accepted = ss.moves_accepted;
-      r.n_smoothing_rejected = ss.moves_rejected;
-      if (opt.optimize_sweeps > 0) {
-        // Sliver removal: raise each node's worst dihedral angle (surface nodes slide on the
-        // surface; feature nodes stay on their features).
-        TetOptimizeOptions to;
-        to.max_sweeps = opt.optimize_sweeps;
-        to.target_dihedral_deg = opt.target_dihedral_deg;
-        to.fixed = fixed_nodes(oc.complex, fe, true);
-        to.project = surface_point;
-        to.surface_normal = surface_normal;
-        to.n_threads = opt.n_threads;
-        // The ranks go from each pass to the next (the points do not move in between).
-        std::vector<double> ranks;
-        to.ranks = &ranks;
-        const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
-        r.n_optimize_moves = ts.moves;
-        if (opt.slide_feature_nodes && slide_on_lines(s, oc.complex, fe, to) > 0) {
-          // More passes with the feature-line nodes sliding along their lines. After the first
-          // pass, not in it: sliding from the start changes every later move and ended worse
-          // on spool L4 (9.55 deg) and fandisk L4 (11.62). No pass can lower the minimum (every
-          // move raises its node's worst tetrahedron); each starts afresh from every node below
-          // the target. Measured (CLI, L4, min dihedral deg, anchor/spool/fandisk): one pass
-          // 8.73/10.24/12.21; + one sliding 11.46/13.08/13.17 (+ one with the lines fixed
-          // instead: 9.49/12.66/13.18); + two sliding 11.55/14.33/13.18; + two sliding and one
-          // with the crease moves below 20 deg (tangent_below_deg) 12.84/14.33/13.18 (that one
-          // as the only extra pass: 12.72/11.79/13.18). Those passes aim at 20 deg, not the
-          // first pass's 30: 12.73/14.30/13.18 instead of 12.84/14.33/13.18, in 14.5/4.6/16.0 s
-          // CPU instead of 24.5/9.7/17.5 (one pass: 13.0/4.1/14.4).
-          to.target_dihedral_deg = std::min(opt.target_dihedral_deg, 20.0);
-          for (int pass = 0; pass < 3; ++pass) {
-            if (pass == 2) to.tangent_below_deg = 20.0;
-            r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
-          }
-        }
-        if (opt.remove_edges_below_deg > 0) {
-          // Node moves stall where the connectivity fixes a wedge (anchor L5: four tetrahedra
-          // around a surface edge whose triangles meet at 62 deg, five under 10 deg). Measured
-          // (CLI, min dihedral deg, base -> edges under 15 deg -> under 30): anchor L5 9.45 ->
-          // 12.20 -> 14.38; L4: sphere966 28.17 -> 28.17 -> 29.93, spool 14.30 (unchanged),
-          // anchor 12.73 -> 16.70 -> 19.56 (25 deg: 19.96, anchor L5 12.81), fandisk 13.18 ->
-          // 14.33 -> 14.34, rotor 16.73 -> 16.73 -> 17.60, elephant 13.80 -> 16.78 (one round) ->
-          // 21.42. Volume and Hausdorff errors the same to 3 digits; CPU about the same (30 deg
-          // with a sort per removal instead of a heap: anchor L5 14.3 s instead of 6.5).
-          EdgeRemovalOptions eo;
-          eo.below_deg = opt.remove_edges_below_deg;
-          // A hex-dominant mesh loses every hex and pyramid of a cell whose tetrahedra change:
-          // there only the tetrahedra under the merge's own bar (sphere966 L4 at 30 deg: hex
-          // volume share 0.999 -> 0.459).
-          if (opt.hex_dominant) eo.below_deg = std::min(eo.below_deg, opt.hex.min_dihedral_deg);
-          eo.surface_normal = surface_normal;
-          eo.n_threads = opt.n_threads;
-          eo.contract_below_deg = opt.contract_edges_below_deg;
-          eo.ranks = &ranks;
-          // Contractions keep the corners. Nodes snapped onto a feature line may go (into a node
-          // of theirs): those the sweeps keep fixed include some whose closest point is on a
-          // face beside the line (fandisk L5: the smooth-surface end of a 0.0012 edge whose
-          // seven tetrahedra stayed under 15 deg).
-          std::vector<std::uint8_t> corners = fixed_nodes(oc.complex, fe, false);
-          for (int round = 0; round < 3; ++round) {
-            eo.keep = corners;
-            const EdgeRemovalStats es = remove_bad_edges(fe.mesh, fe.where, &fe.cell, eo);
-            r.n_edges_removed += es.removed;
-            r.n_edges_contracted += es.contracted;
-            r.n_concave_swaps += es.concave_swapped;
-            for (auto* per_node : {&corners, &to.fixed, &to.on_line}) remap_nodes(es.node_map, *per_node);
-            remap_nodes(es.node_map, fe.where);
-            if (!es.node_map.empty()) {  // the template's node ids -> today's (make_hex_dominant)
-              if (fe.node_map.empty()) fe.node_map = es.node_map;
-              else
-                for (std::int32_t& id : fe.node_map)
-                  if (id >= 0) id = es.node_map[static_cast<std::size_t>(id)];
-            }
-            // With --elements hex those cells stay tetrahedra (make_hex_dominant).
-            std::vector<std::int32_t> changed;
-            std::set_union(fe.cells_changed.begin(), fe.cells_changed.end(), es.cells_changed.begin(),
-                           es.cells_changed.end(), std::back_inserter(changed));
-            fe.cells_changed = std::move(changed);
-            if (es.removed == 0 && es.contracted == 0) break;
-            r.n_optimize_moves += optimize_tets(fe.mesh, fe.where, to).moves;
-          }
-        }
-      }
+      improve_quality(s, oc.complex, fe, opt, surface_point, surface_normal, r, say);
       clock.lap("smoothing");
       add_problems(fe.mesh, inverted_elements(fe.mesh, opt.n_threads), folds_pending ? std::vector<std::size_t>{} : folded_faces(fe.mesh, fe.where, s),
                    " after smoothing", problems);
@@ -1076,7 +1146,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         if (!v.valid) problems = std::move(*folds_pending);
-      } else if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
+      } else if (problems.empty() && before_escobar && !validates(fe.mesh)) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
         // what the max-min untangling alone would have done, refine around its problems. Not
@@ -1103,37 +1173,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       }
     }
     if (problems.empty() && topology_refinements < opt.topology_refinements && !last) {
-      // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the
-      // solid's Euler characteristic is not half the surface's): refine the octants the
-      // surface crosses once more and rebuild, rather than keep a mesh that misses them.
-      const long euler = euler_characteristic<3>(fe.mesh, opt.n_threads);
-      const bool topology_wrong = s.euler_characteristic() % 2 == 0 && euler != s.euler_characteristic() / 2;
-      // Not for islands alone where the island trial showed that one level more does not
-      // resolve them: refining every octant on the surface is that refinement and more (rotor
-      // L5: 14125 octants refined, then 678 -> 338 -> 736 -> 439 problems over the repairs, the
-      // valid mesh before it standing in the end, minutes of CPU later).
-      const bool islands_unresolvable = island_trial_reverted && !topology_wrong;
-      if ((topology_wrong || r.n_islands_dropped > 0) && !islands_unresolvable) {
-        Flags flags(tree.n_leaves(), 0);
-        std::size_t n_marked = 0;
-        for (std::size_t i = 0; i < tree.n_leaves(); ++i)
-          if (sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
-        if (n_marked > 0) {
-          ++topology_refinements;
-          ++r.n_repairs;
-          say("repair " + std::to_string(attempt + 1) + ": refining the " + std::to_string(n_marked) +
-              " octants on the surface (" +
-              (topology_wrong ? "Euler characteristic " + std::to_string(euler) + ", expected " +
-                                    std::to_string(s.euler_characteristic() / 2)
-                              : std::to_string(r.n_islands_dropped) + " octants in islands") +
-              ")");
-          saved = Saved{r, tree, in, oc, std::move(fe), !topology_wrong};
-          n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
-          tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
-          clock.lap("repair refinement");
-          continue;
-        }
-      }
+      std::optional<long> euler;
+      if (!topology_right) euler = euler_characteristic<3>(fe.mesh, opt.n_threads);
+      if (refine_surface_octants(true, euler)) continue;
     }
     if (problems.empty()) {
       if (opt.hex_dominant) {

@@ -395,6 +395,21 @@ TEST_CASE("a fin of a boundary octant is cancelled rather than refined around", 
   CHECK(out.r.n_repairs == 0);
 }
 
+TEST_CASE("a tree with the wrong Euler characteristic is refined before the quality stage", "[pipeline3d][regression]") {
+  // Seed 12's 24x14 torus at level 3 loses its handle on its first tree (Euler 1, expected 0).
+  // The quality stage keeps the topology, so the surface refinement is decided before it and
+  // the stage runs once, on the finer tree (it ran on both before session 27).
+  const fs::path file = fs::path(FEBEMESH_SOURCE_DIR) / "tests" / "dim3" / "regressions" / "torus-seed12-case195-euler.off";
+  std::ifstream in(file);
+  const Outcome3 out = run_surface(Surface(read_off(in, file.string())), file_level(file));
+  INFO(out.v.summary());
+  CHECK(out.v.valid);
+  CHECK(out.r.n_repairs >= 1);
+  const auto smoothing_runs = std::count_if(out.r.times.begin(), out.r.times.end(),
+                                            [](const StageTime3& t) { return t.name == "smoothing"; });
+  CHECK(smoothing_runs == 1);
+}
+
 TEST_CASE("a cheap refusal at a coarse level is meshed one level finer", "[pipeline3d][regression]") {
   // The 4x4x4 voxel union of seed 5, case 180 at level 3: every try is refused (inverted
   // tetrahedra at its concave edges, two octants apart), after about 0.3M octants built;
