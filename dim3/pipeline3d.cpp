@@ -146,39 +146,48 @@ int count_bad(const Mesh<3>& m, const std::vector<std::size_t>& elems, std::int3
 /// tets inverted: the projection of the mean of their surface neighbours (a smoothed
 /// projection, which unfolds crossed projections), halfway there, or the first surface point
 /// along the mean outward normal of their free faces. Every candidate must stay admissible from
-/// all the face nodes projecting onto it. Returns how many nodes moved.
+/// all the face nodes projecting onto it. `bad`: the mesh's inverted elements
+/// (inverted_elements). Returns how many nodes moved.
 std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, bool graze_region,
-                     double graze_length, OctantComplex& oc, TetMesh& fe) {
+                     double graze_length, const std::vector<std::size_t>& bad, OctantComplex& oc, TetMesh& fe) {
   const std::int32_t n_lat = oc.n_lattice(), n_pts = static_cast<std::int32_t>(oc.points.size());
   Mesh<3>& m = fe.mesh;
-  const std::vector<std::size_t> bad = inverted_elements(m);
   if (bad.empty()) return 0;
+  std::set<std::int32_t> movable;
+  for (std::size_t e : bad) {
+    const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    for (int k = 0; k < 4; ++k)
+      if (nodes[k].v >= n_lat && nodes[k].v < n_pts && !oc.snapped[nodes[k].v]) movable.insert(nodes[k].v);
+  }
+  // The lists below only for the movable nodes (and the face nodes projecting onto them), in
+  // the order a list of every node had them: this ran eight times a repair on one thread, over
+  // the whole mesh (elephant L4: ...).
+  std::vector<std::uint8_t> is_movable(static_cast<std::size_t>(n_pts), 0);
+  for (const std::int32_t p : movable) is_movable[p] = 1;
+  const auto movable_node = [&](std::int32_t v) { return v >= n_lat && v < n_pts && is_movable[v]; };
   std::vector<std::vector<std::size_t>> incident(n_pts);
   for (std::size_t e = 0; e < m.solid.size(); ++e) {
     const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
     for (int k = 0; k < 4; ++k)
-      if (nodes[k].v >= n_lat && nodes[k].v < n_pts) incident[nodes[k].v].push_back(e);
+      if (movable_node(nodes[k].v)) incident[nodes[k].v].push_back(e);
   }
   std::vector<std::vector<std::int32_t>> neighbours(n_pts);
   for (std::size_t f = 0; f < m.interface.size(); ++f) {
     const VertexId* nodes = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b)
-        if (a != b && nodes[a].v < n_pts && nodes[a].v >= n_lat) neighbours[nodes[a].v].push_back(nodes[b].v);
+        if (a != b && movable_node(nodes[a].v)) neighbours[nodes[a].v].push_back(nodes[b].v);
   }
   std::vector<std::vector<std::int32_t>> sources(n_pts);
+  std::vector<std::uint8_t> is_source(static_cast<std::size_t>(n_lat), 0);
   for (std::int32_t q = 0; q < n_lat; ++q)
-    if (oc.projection[q] >= 0) sources[oc.projection[q]].push_back(q);
+    if (oc.projection[q] >= 0 && is_movable[oc.projection[q]]) sources[oc.projection[q]].push_back(q), is_source[q] = 1;
   std::vector<P3> normal(n_lat, P3::Zero());
   for (const BoundaryOctant& b : oc.boundary) {
+    if (std::none_of(b.ring.begin(), b.ring.end(), [&](std::int32_t q) { return is_source[q] != 0; })) continue;
     const P3 n = facet_normal<3>(b.face);
-    for (std::int32_t q : b.ring) normal[q] += n;
-  }
-  std::set<std::int32_t> movable;
-  for (std::size_t e : bad) {
-    const VertexId* nodes = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
-    for (int k = 0; k < 4; ++k)
-      if (nodes[k].v >= n_lat && nodes[k].v < n_pts && !oc.snapped[nodes[k].v]) movable.insert(nodes[k].v);
+    for (std::int32_t q : b.ring)
+      if (is_source[q]) normal[q] += n;
   }
   const auto admissible = [&](std::int32_t p, const P3& x) {
     for (std::int32_t q : sources[p]) {
@@ -224,18 +233,24 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
 /// Interface triangles folded over on the surface: their normal points against the surface's
 /// (the sum of the normals of the surface triangles their nodes lie on). Positive tetrahedra do
 /// not exclude this: a surface node can slide over its neighbours, and the mesh then covers a
-/// strip twice (the validator sees its nodes on other elements' facets).
+/// strip twice (the validator sees its nodes on other elements' facets). Marked on n_threads
+/// threads (the same list).
 std::vector<std::size_t> folded_faces(const Mesh<3>& m, const std::vector<BoundaryLocation>& where,
-                                      const SurfaceBoundary& s) {
+                                      const SurfaceBoundary& s, int n_threads) {
+  std::vector<std::uint8_t> folded(m.interface.size(), 0);
+  for_each_range(m.interface.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t f = begin; f < end; ++f) {
+      const VertexId* n = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
+      const P3 &a = m.points[n[0].v], &b = m.points[n[1].v], &c = m.points[n[2].v];
+      P3 ref = P3::Zero();
+      for (int k = 0; k < 3; ++k)
+        if (where[n[k].v].patch >= 0) ref += s.surface().normal(where[n[k].v].patch);
+      folded[f] = surface_alignment(a, b, c, ref) <= 1e-9 ? 1 : 0;
+    }
+  });
   std::vector<std::size_t> out;
-  for (std::size_t f = 0; f < m.interface.size(); ++f) {
-    const VertexId* n = m.interface.nodes(ElemId{static_cast<std::int32_t>(f)});
-    const P3 &a = m.points[n[0].v], &b = m.points[n[1].v], &c = m.points[n[2].v];
-    P3 ref = P3::Zero();
-    for (int k = 0; k < 3; ++k)
-      if (where[n[k].v].patch >= 0) ref += s.surface().normal(where[n[k].v].patch);
-    if (surface_alignment(a, b, c, ref) <= 1e-9) out.push_back(f);
-  }
+  for (std::size_t f = 0; f < folded.size(); ++f)
+    if (folded[f]) out.push_back(f);
   return out;
 }
 
@@ -1060,7 +1075,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           say(untangle_summary("untangling", ts));
         }
         const std::vector<std::size_t> bad = inverted_elements(fe.mesh, opt.n_threads);
-        const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s);
+        const std::vector<std::size_t> folded = folded_faces(fe.mesh, fe.where, s, opt.n_threads);
         std::set<std::int32_t> revert;
         const auto revert_snapped = [&](const Elements& elems, std::size_t e) {
           const VertexId* v = elems.nodes(ElemId{static_cast<std::int32_t>(e)});
@@ -1075,7 +1090,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         if (revert.empty()) {
           const std::size_t moved =
               round < opt.untangle_rounds + 4
-                  ? untangle(tree, in, s, opt.graze, opt.graze_region, opt.graze_length, oc.complex, fe)
+                  ? untangle(tree, in, s, opt.graze, opt.graze_region, opt.graze_length, bad, oc.complex, fe)
                   : 0;
           r.n_untangled += moved;
           if (moved == 0) {
@@ -1091,7 +1106,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
               r.n_untangle_moves += ts.moves;
               say(untangle_summary("untangling (Escobar objective)", ts));
               bad2 = inverted_elements(fe.mesh, opt.n_threads);
-              folded2 = folded_faces(fe.mesh, fe.where, s);
+              folded2 = folded_faces(fe.mesh, fe.where, s, opt.n_threads);
               if (bad2.empty() && folded2.empty()) before_escobar = std::move(old_problems);
             }
             if (bad2.empty() && opt.accept_valid_folds) {
@@ -1136,7 +1151,8 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     if (problems.empty()) {
       improve_quality(s, oc.complex, fe, opt, surface_point, surface_normal, r, say);
       clock.lap("smoothing");
-      add_problems(fe.mesh, inverted_elements(fe.mesh, opt.n_threads), folds_pending ? std::vector<std::size_t>{} : folded_faces(fe.mesh, fe.where, s),
+      add_problems(fe.mesh, inverted_elements(fe.mesh, opt.n_threads),
+                   folds_pending ? std::vector<std::size_t>{} : folded_faces(fe.mesh, fe.where, s, opt.n_threads),
                    " after smoothing", problems);
       if (problems.empty() && folds_pending) {
         // Folded interface triangles where the surface's normals at their nodes disagree (the
