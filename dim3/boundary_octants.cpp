@@ -40,10 +40,11 @@ std::array<std::size_t, 8> octants_around(const LeafKeys<3>& keys, const LP& p) 
   return out;
 }
 
-/// The corners of the free faces of the kept octants, ordered by key (deterministic), each once.
-std::vector<std::pair<std::uint64_t, LP>> free_face_corners(const Orthtree<3>& t, const Flags& in) {
+/// The corners of `facets` (free facets of kept octants), ordered by key (deterministic), each
+/// once.
+std::vector<std::pair<std::uint64_t, LP>> facet_corners(const std::vector<FreeFacet<3>>& facets) {
   std::vector<std::pair<std::uint64_t, LP>> points;
-  for (const FreeFacet<3>& f : free_facets(t, in))
+  for (const FreeFacet<3>& f : facets)
     for (const LP& p : f.corners()) points.emplace_back(point_key<3>(p), p);
   // A key names its point: sorting by key alone leaves equal pairs together.
   std::sort(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
@@ -119,13 +120,38 @@ std::vector<std::int32_t> face_ring(const LatticeNodes<3>& nodes, const Cell<3>&
   return ring;
 }
 
-std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
+/// The octants a pass drops (collected with `in` as it stands, then dropped): look(p, drop) for
+/// each of `points` in order, on n_threads threads (chunks' lists joined in order: the same list).
+template <class Look>
+std::vector<std::size_t> drops_at(const std::vector<std::pair<std::uint64_t, LP>>& points, int n_threads, const Look& look) {
+  constexpr std::size_t chunk = 1 << 12;
+  std::vector<std::vector<std::size_t>> part((points.size() + chunk - 1) / chunk);
+  for_each_chunk(points.size(), chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) look(points[i].second, part[c]);
+  });
+  std::vector<std::size_t> drop;
+  for (const auto& d : part) drop.insert(drop.end(), d.begin(), d.end());
+  return drop;
+}
+
+/// unkeep, answering the leaves it cleared (in the order of `drop`).
+std::vector<std::size_t> unkeep_listed(const std::vector<std::size_t>& drop, Flags& in) {
+  std::vector<std::size_t> cleared;
+  for (std::size_t i : drop)
+    if (i != no_leaf && in[i]) in[i] = 0, cleared.push_back(i);
+  return cleared;
+}
+
+std::size_t remove_pinches(const Orthtree<3>& t, Flags& in, int n_threads) {
   std::size_t removed = 0;
   const LeafKeys<3> keys(t);  // the leaves at a point from flat keys (the tree does not change)
+  // The free facets once, then only around the octants each pass drops (update_free_facets:
+  // the same list; every pass built them and the keys anew, a serial second of elephant L4's
+  // two-thread run).
+  std::vector<FreeFacet<3>> facets = free_facets(t, keys, in);
   for (int pass = 0; pass < 64; ++pass) {
-    const auto points = free_face_corners(t, in);
-    std::vector<std::size_t> drop;
-    for (const auto& [key, p] : points) {
+    const auto points = facet_corners(facets);
+    const std::vector<std::size_t> to_drop = drops_at(points, n_threads, [&](const LP& p, std::vector<std::size_t>& drop) {
       const auto around = octants_around(keys, p);
       const unsigned kept = kept_mask(around, in);
       std::array<int, 8> ck{}, cu{};
@@ -159,10 +185,11 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in) {
           }
         }
       }
-    }
-    const std::size_t n = unkeep(drop, in);
-    removed += n;
-    if (n == 0) break;
+    });
+    const std::vector<std::size_t> cleared = unkeep_listed(to_drop, in);
+    removed += cleared.size();
+    if (cleared.empty()) break;
+    update_free_facets(t, keys, in, cleared, facets);
   }
   return removed;
 }
@@ -180,7 +207,7 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
   };
   const LeafKeys<3> keys(t);
   for (int pass = 0; pass < 8; ++pass) {
-    const auto points = free_face_corners(t, in);
+    const auto points = facet_corners(free_facets(t, keys, in));
     std::vector<std::size_t> drop;
     for (const auto& [key, p] : points) {
       const auto around = octants_around(keys, p);

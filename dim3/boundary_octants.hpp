@@ -91,8 +91,9 @@ struct OctantComplexResult {
 
 /// Drop interior octants so that the interior region is a manifold around every node of its
 /// boundary: around each free-face corner the kept and the unkept ones among the eight octants
-/// must each be face-connected. Returns how many octants were dropped.
-std::size_t remove_pinches(const Orthtree<3>& t, Flags& in);
+/// must each be face-connected. Returns how many octants were dropped. On n_threads threads
+/// (the same octants dropped).
+std::size_t remove_pinches(const Orthtree<3>& t, Flags& in, int n_threads = 1);
 
 /// Drop interior octants so that no node of the interior region's boundary has free faces on
 /// both sides along an axis (a staircase twisted around the node: kept and unkept octants each

@@ -904,14 +904,14 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     Flags in = interior_flags(sides);
     r.n_buffer_dropped = apply_buffer_rules(tree, in, s, opt);
     r.n_peeled = peel(tree, in, peel_points);
-    r.n_pinches_dropped = remove_pinches(tree, in);
+    r.n_pinches_dropped = remove_pinches(tree, in, opt.n_threads);
     r.n_opposing_dropped = 0;
     const auto depth_at = [&s](const P3& p) { return s.closest_point(p).distance; };
     for (int round = 0; opt.drop_opposing && round < 4; ++round) {
       const std::size_t k = remove_opposing(tree, in, depth_at);
       if (k == 0) break;
       r.n_opposing_dropped += k;
-      r.n_pinches_dropped += remove_pinches(tree, in);
+      r.n_pinches_dropped += remove_pinches(tree, in, opt.n_threads);
     }
     const Flags before_islands = in;
     r.n_islands_dropped = keep_largest_components(tree, in, s.n_components());
@@ -975,7 +975,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         continue;
       }
     }
-    if (r.n_islands_dropped > 0) r.n_pinches_dropped += remove_pinches(tree, in);
+    if (r.n_islands_dropped > 0) r.n_pinches_dropped += remove_pinches(tree, in, opt.n_threads);
     say("interior octants: " + std::to_string(r.n_buffer_dropped) + " dropped by the buffer rule, " +
         std::to_string(r.n_peeled) + " peeled, " + std::to_string(r.n_pinches_dropped) + " for pinches, " +
         (r.n_opposing_dropped > 0 ? std::to_string(r.n_opposing_dropped) + " for opposing free faces, " : std::string()) +
