@@ -61,16 +61,13 @@ unsigned kept_mask(const std::array<std::size_t, 8>& around, const Flags& in) {
   return kept;
 }
 
-/// Clears in[i] for the leaves in `drop` (no_leaf and repeats allowed); returns how many were set.
-std::size_t unkeep(const std::vector<std::size_t>& drop, Flags& in) {
-  std::size_t n = 0;
-  for (std::size_t i : drop) {
-    if (i != no_leaf && in[i]) {
-      in[i] = 0;
-      ++n;
-    }
-  }
-  return n;
+/// Clears in[i] for the leaves in `drop` (no_leaf and repeats allowed); returns the leaves it
+/// cleared, in the order of `drop`.
+std::vector<std::size_t> unkeep(const std::vector<std::size_t>& drop, Flags& in) {
+  std::vector<std::size_t> cleared;
+  for (std::size_t i : drop)
+    if (i != no_leaf && in[i]) in[i] = 0, cleared.push_back(i);
+  return cleared;
 }
 
 /// Face-connected components of the octants in `mask` within the 2x2x2 block (octants are
@@ -134,14 +131,6 @@ std::vector<std::size_t> drops_at(const std::vector<std::pair<std::uint64_t, LP>
   return drop;
 }
 
-/// unkeep, answering the leaves it cleared (in the order of `drop`).
-std::vector<std::size_t> unkeep_listed(const std::vector<std::size_t>& drop, Flags& in) {
-  std::vector<std::size_t> cleared;
-  for (std::size_t i : drop)
-    if (i != no_leaf && in[i]) in[i] = 0, cleared.push_back(i);
-  return cleared;
-}
-
 std::size_t remove_pinches(const Orthtree<3>& t, Flags& in, int n_threads) {
   std::size_t removed = 0;
   const LeafKeys<3> keys(t);  // the leaves at a point from flat keys (the tree does not change)
@@ -186,7 +175,7 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in, int n_threads) {
         }
       }
     });
-    const std::vector<std::size_t> cleared = unkeep_listed(to_drop, in);
+    const std::vector<std::size_t> cleared = unkeep(to_drop, in);
     removed += cleared.size();
     if (cleared.empty()) break;
     update_free_facets(t, keys, in, cleared, facets);
@@ -237,7 +226,7 @@ std::size_t remove_opposing(const Orthtree<3>& t, Flags& in, const std::function
         break;
       }
     }
-    const std::size_t n = unkeep(drop, in);
+    const std::size_t n = unkeep(drop, in).size();
     removed += n;
     if (n == 0) break;
   }
