@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "core/error.hpp"
@@ -227,7 +228,7 @@ double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<D
   sb.expand(a);
   sb.expand(b);
   std::vector<std::pair<double, double>> parts;
-  double largest = 0.0;
+  double smallest = std::numeric_limits<double>::infinity();
   for (std::size_t i : leaves_in_box(t, sb)) {
     if (!keep[i]) continue;
     Box<Dim> box = geometry(t, t.leaf(i));
@@ -237,7 +238,7 @@ double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<D
     const auto part = interval_in_open_box(box, a, b);
     if (part.first >= part.second) continue;
     parts.push_back(part);
-    largest = std::max(largest, size);
+    smallest = std::min(smallest, size);
   }
   if (parts.empty()) return 0.0;
   std::sort(parts.begin(), parts.end());
@@ -247,7 +248,7 @@ double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<D
     else hi = std::max(hi, t1);
   }
   covered += hi - lo;
-  return covered * (b - a).norm() / largest;
+  return covered * (b - a).norm() / smallest;
 }
 
 template struct FreeFacet<2>;

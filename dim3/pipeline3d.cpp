@@ -960,6 +960,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     // Set when the Escobar pass made this tree's mesh positive: the problems the old path would
     // have reported, in case the mesh turns out not to be conforming after all.
     std::optional<std::vector<Problem3>> before_escobar;
+    std::vector<P3> at_fault_before_escobar;  // with opt.repair_at_cells: where those lie
     std::vector<P3> behind;  // lattice nodes behind what the untangling left inverted or folded
     std::vector<P3> at_fault;  // with opt.repair_at_cells: where the repair refines instead
     // Set when the untangling left folded interface triangles but no inverted tetrahedron and
@@ -1007,6 +1008,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             if (opt.escobar_sweeps > 0) {
               std::vector<Problem3> old_problems;
               add_problems(fe.mesh, bad, folded, "", old_problems);
+              if (opt.repair_at_cells)
+                at_fault_before_escobar =
+                    fault_places(tree, oc.complex, fe, bad, nodes_behind(tree, oc.complex, fe.mesh, bad, folded));
               const TetOptimizeStats ts =
                   untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal, opt.n_threads, bounds);
               r.n_untangle_moves += ts.moves;
@@ -1145,13 +1149,29 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         if (!v.valid) problems = std::move(*folds_pending);
-      } else if (problems.empty() && before_escobar && !validate(fe.mesh, ValidateOptions<3>{}).valid) {
+      } else if (problems.empty() && before_escobar) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
         // what the max-min untangling alone would have done, refine around its problems. Not
         // after the validation above, whose checks include these.
-        say("untangling (Escobar objective): the mesh does not conform; refining instead");
-        problems = std::move(*before_escobar);
+        const ValidationReport v = validate(fe.mesh, ValidateOptions<3>{});
+        if (!v.valid) {
+          say("untangling (Escobar objective): the mesh does not conform; refining instead");
+          problems = std::move(*before_escobar);
+          at_fault = std::move(at_fault_before_escobar);
+          if (opt.repair_at_cells) {
+            // The problems are where it does not conform (counted as such: the inverted
+            // tetrahedra before the Escobar pass are not this tree's count), refined around
+            // with the faults behind those tetrahedra.
+            std::vector<Problem3> sites;
+            for (const auto& site : v.sites)
+              if (site.node >= 0) sites.push_back({fe.mesh.points[static_cast<std::size_t>(site.node)], site.kind});
+            if (!sites.empty()) {
+              for (const Problem3& p : sites) at_fault.push_back(p.where);
+              problems = std::move(sites);
+            }
+          }
+        }
       }
       if (problems.empty()) {
         // The checks above see inverted tetrahedra and folds, not a surface mesh that touches
