@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "core/error.hpp"
 
@@ -144,6 +146,26 @@ double share_in_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<D
   return t1 - t0;
 }
 
+/// The parameters [t0, t1] of the part of segment [a, b] in the open box `box`; t0 >= t1 when
+/// it misses the box.
+template <int Dim>
+std::pair<double, double> interval_in_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int d = 0; d < Dim; ++d) {
+    const double dir = b[d] - a[d];
+    if (std::abs(dir) < 1e-300) {
+      if (a[d] <= box.lo[d] || a[d] >= box.hi[d]) return {1.0, 0.0};
+      continue;
+    }
+    double s0 = (box.lo[d] - a[d]) / dir, s1 = (box.hi[d] - a[d]) / dir;
+    if (s0 > s1) std::swap(s0, s1);
+    t0 = std::max(t0, s0);
+    t1 = std::min(t1, s1);
+    if (t0 >= t1) return {1.0, 0.0};
+  }
+  return {t0, t1};
+}
+
 /// Does the segment meet the open box `box`?
 template <int Dim>
 bool segment_meets_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
@@ -199,6 +221,36 @@ bool segment_enters_kept_region(const Orthtree<Dim>& t, const Flags& keep, const
   return false;
 }
 
+template <int Dim>
+double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
+                        double rel_tol) {
+  Box<Dim> sb = Box<Dim>::empty();
+  sb.expand(a);
+  sb.expand(b);
+  std::vector<std::pair<double, double>> parts;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (std::size_t i : leaves_in_box(t, sb)) {
+    if (!keep[i]) continue;
+    Box<Dim> box = geometry(t, t.leaf(i));
+    const double size = box.hi[0] - box.lo[0];
+    box.lo.array() -= rel_tol * size;
+    box.hi.array() += rel_tol * size;
+    const auto part = interval_in_open_box(box, a, b);
+    if (part.first >= part.second) continue;
+    parts.push_back(part);
+    smallest = std::min(smallest, size);
+  }
+  if (parts.empty()) return 0.0;
+  std::sort(parts.begin(), parts.end());
+  double covered = 0.0, lo = parts[0].first, hi = parts[0].second;
+  for (const auto& [t0, t1] : parts) {
+    if (t0 > hi) covered += hi - lo, lo = t0, hi = t1;
+    else hi = std::max(hi, t1);
+  }
+  covered += hi - lo;
+  return covered * (b - a).norm() / smallest;
+}
+
 template struct FreeFacet<2>;
 template struct FreeFacet<3>;
 template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const Flags&);
@@ -211,6 +263,8 @@ template void update_free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, cons
                                     std::vector<FreeFacet<3>>&);
 template bool segment_enters_kept<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&, double);
 template bool segment_enters_kept<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&, double);
+template double cells_along_kept<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&, double);
+template double cells_along_kept<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&, double);
 template bool segment_enters_kept_region<2>(const Orthtree<2>&, const Flags&, const Point<2>&, const Point<2>&,
                                              double, double);
 template bool segment_enters_kept_region<3>(const Orthtree<3>&, const Flags&, const Point<3>&, const Point<3>&,

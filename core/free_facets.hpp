@@ -52,4 +52,12 @@ template <int Dim>
 bool segment_enters_kept_region(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
                                 double rel_tol, double graze_length = 0.0);
 
+/// The length of segment [a, b] that runs within `rel_tol` of their size of kept leaves (the
+/// union of its parts in their boxes grown by that much), in units of the smallest such leaf's
+/// size; 0 when it passes near none. A projection that runs along the kept region's boundary
+/// (on a lattice line at its edge) has a long such run and enters no leaf.
+template <int Dim>
+double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
+                        double rel_tol);
+
 }  // namespace febemesh

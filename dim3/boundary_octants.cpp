@@ -330,6 +330,7 @@ struct Projector {
   bool outward_all_faces = false;
   bool graze_region = false;  // BoundaryOctantOptions::graze_region, graze_length
   double graze_length = 0.0;
+  double backward_along = 0.0;  // BoundaryOctantOptions::backward_along
 
   /// The segment from q to a surface point p (on triangle `patch`, -1 = unknown) leaves through
   /// one of q's free faces (`dirs`, bit f = face f) and lands on a side of the surface facing
@@ -338,7 +339,19 @@ struct Projector {
   bool admissible(const P3& q, const P3& p, std::uint8_t dirs = 0, std::int32_t patch = -1) const {
     if (dirs != 0 && !leaves_outward(q, p, dirs, patch)) return false;
     if (enters_interior(tree, in, q, p, graze, graze_region, graze_length)) return false;
+    if (graze_region && backward_along > 0 && dirs != 0 && runs_back_along(q, p, dirs)) return false;
     return !surface.crosses_before(q, p);
+  }
+  /// The segment from q to p runs back against one of q's free faces (cosine -0.5 or less)
+  /// and along the interior octants for more than backward_along octant sizes.
+  bool runs_back_along(const P3& q, const P3& p, std::uint8_t dirs) const {
+    const P3 d = p - q;
+    const double len = d.norm();
+    if (len <= 0) return false;
+    bool back = false;
+    for (int f = 0; f < Cube<3>::n_faces; ++f)
+      if (((dirs >> f) & 1) && along_face(d, f) / len <= -0.5) back = true;
+    return back && cells_along_kept(tree, in, q, p, graze) > backward_along;
   }
   /// Some free face f of q has cos(p - q, n_f) >= min_outward and cos(n_p, n_f) >= min_facing:
   /// a projection that runs back along the interior octants, or lands on the far side of a part
@@ -755,7 +768,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   // Project every face node (closest point, then the next local minima; paper eq. 1 with the
   // crossing rule). Equal projections share one surface node.
   Projector proj{t, in, s, opt.graze, opt.min_outward, opt.min_facing, opt.outward_all_faces, opt.graze_region,
-                 opt.graze_length};
+                 opt.graze_length, opt.backward_along};
   // Each node's projection depends on the node alone: found on opt.n_threads threads, then
   // counted, shared and numbered in node order (the same nodes for every thread count).
   enum class How : std::uint8_t { none, closest, next_normal, ray, blind, problem };

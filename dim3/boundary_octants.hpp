@@ -133,6 +133,13 @@ struct BoundaryOctantOptions {
   /// With graze_region: a segment running along an interior octant for more than this x its
   /// size enters it (0 = off; segment_enters_kept_region's graze_length).
   double graze_length = 0.0;
+  /// With graze_region: a projection backward against a free face of its node (cosine with the
+  /// face's outward normal at most -0.5) that runs along the interior octants (within the graze
+  /// allowance, cells_along_kept) for more than this many octant sizes is refused (0 = off):
+  /// the rim-edge case of rotor's sampled thickness try (branch rotor3), nodes under an
+  /// overhang projecting along the interior region's own boundary. Off: no try sets it
+  /// (docs/measurements.md, branch rotor4).
+  double backward_along = 0.0;
   /// A projection must leave its node through one of the node's free faces: the cosine between
   /// the segment and that face's outward normal at least min_outward, and the cosine between the
   /// surface normal where it lands and that face's normal at least min_facing (-1 = no such

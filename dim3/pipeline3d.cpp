@@ -354,8 +354,10 @@ std::size_t slide_on_lines(const SurfaceBoundary& s, const OctantComplex& oc, co
 /// `escobar` the smooth last resort. Surface nodes stay on the surface, corners stay put.
 TetOptimizeStats untangle_pass(TetMesh& fe, const OctantComplex& oc, int sweeps, bool escobar,
                                const SurfaceProjection& project,
-                               const std::function<P3(const BoundaryLocation&)>& normal, int n_threads) {
+                               const std::function<P3(const BoundaryLocation&)>& normal, int n_threads,
+                               const std::vector<Box<3>>& bounds = {}) {
   TetOptimizeOptions to;
+  to.bounds = bounds;
   to.untangle_only = true;
   to.escobar = escobar;
   to.max_sweeps = sweeps;
@@ -378,6 +380,68 @@ void add_problems(const Mesh<3>& m, const std::vector<std::size_t>& bad, const s
                   const std::string& when, std::vector<Problem3>& out) {
   for (std::size_t e : bad) out.push_back({centroid(m, e), "an element is inverted" + when});
   for (std::size_t f : folded) out.push_back({face_centroid(m, f), "the surface mesh folds" + when});
+}
+
+/// The size of cell `c` of fe.cell (an interior octant, or a boundary octant's face) and the
+/// leaf box of an interior one (empty for a boundary octant).
+double cell_size(const Orthtree<3>& t, const OctantComplex& oc, std::int32_t c) {
+  const std::size_t n_int = oc.interior.size();
+  const Cell<3>& cell = static_cast<std::size_t>(c) < n_int ? t.leaf(oc.interior[c]) : oc.boundary[c - n_int].cell;
+  return geometry(t, cell).extent()[0];
+}
+
+/// Per node of fe: the box the untangling's moves keep it in (Options3d::untangle_reach), for
+/// the nodes off the surface: the bounding box of its cells' nodes as built, each grown by
+/// `reach` x the cell's size. Surface nodes get an empty box (unbounded).
+std::vector<Box<3>> move_bounds(const Orthtree<3>& t, const OctantComplex& oc, const TetMesh& fe, double reach) {
+  const Mesh<3>& m = fe.mesh;
+  std::vector<Box<3>> cell_box(oc.interior.size() + oc.boundary.size(), Box<3>::empty());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const VertexId* v = m.solid.nodes(id);
+    for (int k = 0; k < m.solid.n_nodes_of(id); ++k) cell_box[fe.cell[e]].expand(m.points[v[k].v]);
+  }
+  for (std::size_t c = 0; c < cell_box.size(); ++c) {
+    if (cell_box[c].lo.x() > cell_box[c].hi.x()) continue;
+    const double grow = reach * cell_size(t, oc, static_cast<std::int32_t>(c));
+    cell_box[c].lo.array() -= grow;
+    cell_box[c].hi.array() += grow;
+  }
+  std::vector<Box<3>> out(m.points.size(), Box<3>::empty());
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const VertexId* v = m.solid.nodes(id);
+    for (int k = 0; k < m.solid.n_nodes_of(id); ++k) {
+      const std::size_t u = static_cast<std::size_t>(v[k].v);
+      if (u < fe.where.size() && fe.where[u].patch >= 0) continue;
+      out[u].expand(cell_box[fe.cell[e]].lo);
+      out[u].expand(cell_box[fe.cell[e]].hi);
+    }
+  }
+  return out;
+}
+
+/// Where the faults behind the inverted tets `bad` lie (Options3d::repair_at_cells): the centre
+/// of the cell each came from (an interior octant, or a boundary octant's face) and `behind`,
+/// the lattice nodes behind them and the folded triangles (nodes_behind).
+std::vector<P3> fault_places(const Orthtree<3>& t, const OctantComplex& oc, const TetMesh& fe,
+                             const std::vector<std::size_t>& bad, const std::vector<P3>& behind) {
+  const std::size_t n_int = oc.interior.size();
+  std::set<std::int32_t> cells;
+  for (std::size_t e : bad) cells.insert(fe.cell[e]);
+  std::vector<P3> out;
+  for (std::int32_t c : cells) {
+    if (static_cast<std::size_t>(c) < n_int) {
+      out.push_back(geometry(t, t.leaf(oc.interior[c])).center());
+    } else {
+      const BoundaryOctant& b = oc.boundary[static_cast<std::size_t>(c) - n_int];
+      P3 centre = P3::Zero();
+      for (std::int32_t q : b.ring) centre += oc.points[q];
+      out.push_back(centre / static_cast<double>(b.ring.size()));
+    }
+  }
+  out.insert(out.end(), behind.begin(), behind.end());
+  return out;
 }
 
 /// The lattice nodes behind the inverted tets `bad` and folded interface triangles `folded`:
@@ -1003,6 +1067,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     bo.graze = opt.graze;
     bo.graze_region = opt.graze_region;
     bo.graze_length = opt.graze_length;
+    bo.backward_along = opt.backward_along;
     bo.min_outward = opt.min_outward;
     bo.min_facing = opt.min_facing;
     bo.outward_all_faces = opt.outward_all_faces;
@@ -1017,16 +1082,17 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     // Set when the Escobar pass made this tree's mesh positive: the problems the old path would
     // have reported, in case the mesh turns out not to be conforming after all.
     std::optional<std::vector<Problem3>> before_escobar;
+    std::vector<P3> at_fault_before_escobar;  // with opt.repair_at_cells: where those lie
     std::vector<P3> behind;  // lattice nodes behind what the untangling left inverted or folded
+    std::vector<P3> at_fault;  // with opt.repair_at_cells: where the repair refines instead
     // Set when the untangling left folded interface triangles but no inverted tetrahedron and
     // opt.accept_valid_folds: the folds, refined around unless the smoothed mesh validates.
     std::optional<std::vector<Problem3>> folds_pending;
-    // Whether the mesh passes the validator's checks without the surface's (on all threads: the
-    // same answer).
-    const auto validates = [&](const Mesh<3>& m) {
+    // The validator's checks without the surface's (on all threads: the same report).
+    const auto validation = [&](const Mesh<3>& m) {
       ValidateOptions<3> vo;
       vo.n_threads = opt.n_threads;
-      return validate(m, vo).valid;
+      return validate(m, vo);
     };
     // Parts thinner than the octants fall apart (islands dropped) or lose a handle (the
     // solid's Euler characteristic is not half the surface's): refine the octants the surface
@@ -1066,11 +1132,13 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
       // Feature snaps that invert an element are undone, then the templates are redone.
       for (int round = 0;; ++round) {
         fe = tetrahedralize(tree, oc.complex, surface_point, opt.n_threads);
+        const std::vector<Box<3>> bounds =
+            opt.untangle_reach > 0 ? move_bounds(tree, oc.complex, fe, opt.untangle_reach) : std::vector<Box<3>>{};
         {
           // Untangle by moving nodes (interior ones freely, surface ones on the surface,
           // corners not at all) before giving up snaps or refining.
           const TetOptimizeStats ts =
-              untangle_pass(fe, oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads);
+              untangle_pass(fe, oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads, bounds);
           r.n_untangle_moves += ts.moves;
           say(untangle_summary("untangling", ts));
         }
@@ -1101,8 +1169,11 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             if (opt.escobar_sweeps > 0) {
               std::vector<Problem3> old_problems;
               add_problems(fe.mesh, bad, folded, "", old_problems);
+              if (opt.repair_at_cells)
+                at_fault_before_escobar =
+                    fault_places(tree, oc.complex, fe, bad, nodes_behind(tree, oc.complex, fe.mesh, bad, folded));
               const TetOptimizeStats ts =
-                  untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal, opt.n_threads);
+                  untangle_pass(fe, oc.complex, opt.escobar_sweeps, true, surface_point, surface_normal, opt.n_threads, bounds);
               r.n_untangle_moves += ts.moves;
               say(untangle_summary("untangling (Escobar objective)", ts));
               bad2 = inverted_elements(fe.mesh, opt.n_threads);
@@ -1119,6 +1190,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             }
             add_problems(fe.mesh, bad2, folded2, "", problems);
             if (!(bad2.empty() && folded2.empty())) behind = nodes_behind(tree, oc.complex, fe.mesh, bad2, folded2);
+            if (opt.repair_at_cells) at_fault = fault_places(tree, oc.complex, fe, bad2, behind);
             break;
           }
           continue;
@@ -1144,7 +1216,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     if (problems.empty() && !folds_pending && topology_refinements < opt.topology_refinements && !last) {
       const long euler = euler_characteristic<3>(fe.mesh, opt.n_threads);
       topology_right = s.euler_characteristic() % 2 != 0 || euler == s.euler_characteristic() / 2;
-      if (!topology_right && (!before_escobar || validates(fe.mesh)) &&
+      if (!topology_right && (!before_escobar || validation(fe.mesh).valid) &&
           refine_surface_octants(false, euler))
         continue;
     }
@@ -1162,13 +1234,29 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         if (!v.valid) problems = std::move(*folds_pending);
-      } else if (problems.empty() && before_escobar && !validates(fe.mesh)) {
+      } else if (problems.empty() && before_escobar) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
         // what the max-min untangling alone would have done, refine around its problems. Not
         // after the validation above, whose checks include these.
-        say("untangling (Escobar objective): the mesh does not conform; refining instead");
-        problems = std::move(*before_escobar);
+        const ValidationReport v = validation(fe.mesh);
+        if (!v.valid) {
+          say("untangling (Escobar objective): the mesh does not conform; refining instead");
+          problems = std::move(*before_escobar);
+          at_fault = std::move(at_fault_before_escobar);
+          if (opt.repair_at_cells) {
+            // The problems are where it does not conform (counted as such: the inverted
+            // tetrahedra before the Escobar pass are not this tree's count), refined around
+            // with the faults behind those tetrahedra.
+            std::vector<Problem3> sites;
+            for (const auto& site : v.sites)
+              if (site.node >= 0) sites.push_back({fe.mesh.points[static_cast<std::size_t>(site.node)], site.kind});
+            if (!sites.empty()) {
+              for (const Problem3& p : sites) at_fault.push_back(p.where);
+              problems = std::move(sites);
+            }
+          }
+        }
       }
       if (problems.empty()) {
         // The checks above see inverted tetrahedra and folds, not a surface mesh that touches
@@ -1243,6 +1331,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     Flags flags;
     std::vector<P3> places;
     for (const Problem3& pr : problems) places.push_back(pr.where);
+    if (!at_fault.empty()) places = at_fault;
     const bool stuck = last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags);
     if (stuck && saved && saved->topology_right) {
       // The finer tree could not be built: the valid coarser mesh stands (with its volume
@@ -1262,7 +1351,8 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     ++r.n_repairs;
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
-        " place(s): " + describe(problems));
+        " place(s)" + (at_fault.empty() ? std::string() : " (at " + std::to_string(at_fault.size()) + " cells and nodes behind them)") +
+        ": " + describe(problems));
     tree = balance_2to1(refine(tree, flags), BalanceKind::Full, balancing);
     peel_rounds = 0;
     clock.lap("repair refinement");

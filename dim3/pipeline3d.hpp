@@ -70,6 +70,18 @@ struct Options3d {
   /// graze_length 0.5 on top of it doubled the first tree's problems).
   bool graze_region = false;
   double graze_length = 0.0;
+  /// Where the untangling leaves inverted tetrahedra or folded interface triangles, refine
+  /// around the cells they came from and the lattice nodes behind them (their own and the face
+  /// nodes projecting onto their surface nodes) instead of their centroids: the untangling can
+  /// drag a template node far from its cell (rotor's sampled thickness try, branch rotor3: a fan
+  /// centre 171 octants away), and the centroids then lie far from the fault. Off: no try sets
+  /// it (docs/measurements.md, branch rotor4).
+  bool repair_at_cells = false;
+  double backward_along = 0.0;  ///< BoundaryOctantOptions::backward_along (off: see there)
+  /// The untangling's moves of nodes off the surface (lattice and template nodes) stay within
+  /// the bounding box of their cells as built, grown by this x the cells' size; 0 = unbounded.
+  /// Off: no try sets it (docs/measurements.md, branch rotor4).
+  double untangle_reach = 0.0;
   /// Projection admissibility (BoundaryOctantOptions min_outward, min_facing, outward_all_faces).
   double min_outward = -1.0;
   double min_facing = -1.0;

@@ -397,6 +397,12 @@ struct Optimizer {
       x = c;
     }
   }
+  /// Whether x is in the box node v's moves stay in (TetOptimizeOptions::bounds).
+  bool within(std::int32_t v, const P3& x) const {
+    if (opt.bounds.empty()) return true;
+    const Box<3>& b = opt.bounds[static_cast<std::size_t>(v)];
+    return b.lo.x() > b.hi.x() || b.contains(x);
+  }
   bool movable(std::int32_t v) const {
     if (!opt.fixed.empty() && opt.fixed[v]) return false;
     if (is_surface(v) && !opt.project) return false;
@@ -518,6 +524,7 @@ struct Optimizer {
       P3 x;
       BoundaryLocation w;
       place(v, x0, c, x, w);
+      if (!within(v, x)) continue;
       double f = avx ? lanes_worst_above_avx(local, sc.quads.data(), trial.data(), x, best + 1e-12, worst_local)
                      : lanes_worst_above<2>(local, sc.pairs.data(), trial.data(), x, best + 1e-12, worst_local);
       if (guard && f > best + 1e-12) f = std::min(f, faces_worst(v, x, opt.surface_normal(w)));
@@ -529,7 +536,7 @@ struct Optimizer {
       P3 ex;
       BoundaryLocation ew;
       const P3 from = best_x;
-      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0)) {
+      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0) && within(v, ex)) {
         best_x = ex, best_w = ew;
         for (std::size_t k = 0; k < local.size(); ++k) best_ranks[k] = local[k].rank(ex);
       }

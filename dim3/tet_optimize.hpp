@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "core/boundary.hpp"
+#include "core/box.hpp"
 #include "core/mesh.hpp"
 
 namespace febemesh::dim3 {
@@ -49,6 +50,9 @@ struct TetOptimizeOptions {
   /// needs slide. Fixed nodes never move.
   std::vector<std::uint8_t> on_line;
   LineProjection slide;
+  /// Per node: the box its moves stay in (a candidate outside it is not taken). Empty = none;
+  /// an empty box (lo > hi) = unbounded.
+  std::vector<Box<3>> bounds;
   /// Only untangle: stop a node as soon as its tetrahedra are all positive.
   bool untangle_only = false;
   /// With untangle_only: where the max-min candidates leave a node's tetrahedra inverted,

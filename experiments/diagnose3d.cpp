@@ -208,6 +208,9 @@ constexpr const char* usage =
     "  --opposing            drop interior octants at nodes with opposing free faces\n"
     "  --thin-share          print the share of the surface thinner than 0.5-2 octants, and stop\n"
     "  --root-shift X Y Z    SurfaceOptions::root_shift (the root cube moved by these shares of its side)\n"
+    "  --repair-at-cells     Options3d::repair_at_cells (refine at the cells behind the untangling's faults)\n"
+    "  --untangle-reach R    Options3d::untangle_reach (the untangling's moves off the surface bounded)\n"
+    "  --backward-along C    with --graze-region: BoundaryOctantOptions::backward_along\n"
     "whole pipeline:\n"
     "  --pipeline            run mesh3d and print its verdict, tets, min dihedral, volume error\n"
     "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin;\n"
@@ -229,7 +232,8 @@ int option_values(const std::string& a) {
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
       {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1},
-      {"--graze-region", 0}, {"--graze-length", 1}, {"--root-shift", 3}};
+      {"--graze-region", 0}, {"--graze-length", 1}, {"--root-shift", 3}, {"--repair-at-cells", 0},
+      {"--untangle-reach", 1}, {"--backward-along", 1}};
   for (const auto& [name, n] : known)
     if (a == name) return n;
   return -1;
@@ -295,6 +299,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--outward") bo.min_outward = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--facing") bo.min_facing = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--graze-length") bo.graze_length = std::atof(argv[i + 1]);
+    if (std::string(argv[i]) == "--backward-along") bo.backward_along = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--dump") dump = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--only") only = std::atoi(argv[i + 1]);
   }
@@ -309,10 +314,14 @@ int main(int argc, char** argv) {
   opt.unfold_backward = bo.unfold_backward;
   opt.graze_region = bo.graze_region;
   opt.graze_length = bo.graze_length;
+  opt.backward_along = bo.backward_along;
   for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--accept-folds") opt.accept_valid_folds = true;
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--repair-at-cells") opt.repair_at_cells = true;
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::string(argv[i]) == "--peel-rounds") opt.peel_rounds = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--untangle-reach") opt.untangle_reach = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--buffer") opt.buffer = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--flat-buffer") opt.flat_buffer = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--max-level") opt.max_level = std::atoi(argv[i + 1]);

@@ -99,3 +99,26 @@ TEMPLATE_TEST_CASE_SIG("segment_enters_kept_region: the graze allowance only at 
   CHECK(segment_enters_kept(t, keep, a, b, 0.05));
   CHECK(segment_enters_kept_region(t, keep, a, b, 0.05));
 }
+
+TEMPLATE_TEST_CASE_SIG("cells_along_kept: the run along the kept leaves in leaf sizes", "[free_facets]",
+                       ((int Dim), Dim), 2, 3) {
+  // The unit cube in 4^Dim leaves of size 0.25, the lower half along axis 0 kept (x < 0.5).
+  Orthtree<Dim> t;
+  for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
+  Flags keep(t.n_leaves());
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
+  // On the region's boundary plane x = 0.5 from y 0.05 to 0.95: 0.9 = 3.6 leaf sizes along it.
+  a[0] = b[0] = 0.5;
+  a[1] = 0.05;
+  b[1] = 0.95;
+  CHECK(cells_along_kept(t, keep, a, b, 0.05) == Approx(3.6));
+  // 0.1 outside it (0.4 of a leaf, more than the allowance): none.
+  a[0] = b[0] = 0.6;
+  CHECK(cells_along_kept(t, keep, a, b, 0.05) == 0.0);
+  // Straight out of the region from its boundary: only the allowance's 0.0125.
+  a[0] = b[0] = 0.5;
+  b[1] = a[1];
+  b[0] = 0.9;
+  CHECK(cells_along_kept(t, keep, a, b, 0.05) == Approx(0.05));
+}

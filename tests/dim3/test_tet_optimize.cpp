@@ -293,3 +293,47 @@ TEST_CASE("ranks handed between sweeps and edge removal are a pass's own, and ch
     }
   }
 }
+
+TEST_CASE("optimize_tets keeps each node in its bounds box; empty boxes bound nothing", "[tet_optimize]") {
+  for (const unsigned seed : {1u, 2u}) {
+    const Mesh<3> start = jittered_cube(0.6, seed);
+    std::vector<BoundaryLocation> where(start.points.size());
+    TetOptimizeOptions opt;
+    opt.max_sweeps = 16;
+    opt.fixed.assign(start.points.size(), 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v) {
+      const P3& p = start.points[v];
+      opt.fixed[v] = p.minCoeff() == 0.0 || p.maxCoeff() == 4.0 ? 1 : 0;
+    }
+    // Unbounded, the optimiser moves nodes further than 0.02.
+    Mesh<3> free_mesh = start;
+    std::vector<BoundaryLocation> w1 = where;
+    optimize_tets(free_mesh, w1, opt);
+    double far = 0.0;
+    for (std::size_t v = 0; v < start.points.size(); ++v)
+      far = std::max(far, (free_mesh.points[v] - start.points[v]).cwiseAbs().maxCoeff());
+    CHECK(far > 0.02);
+    // Empty boxes: the same mesh as without bounds.
+    Mesh<3> empty_boxes = start;
+    std::vector<BoundaryLocation> w2 = where;
+    TetOptimizeOptions with_empty = opt;
+    with_empty.bounds.assign(start.points.size(), Box<3>::empty());
+    optimize_tets(empty_boxes, w2, with_empty);
+    CHECK(empty_boxes.points == free_mesh.points);
+    // Boxes of +-0.02 around the start: every node stays in its own, none inverts.
+    Mesh<3> bounded = start;
+    std::vector<BoundaryLocation> w3 = where;
+    TetOptimizeOptions tight = opt;
+    for (const P3& p : start.points) {
+      Box<3> b;
+      b.lo = p.array() - 0.02;
+      b.hi = p.array() + 0.02;
+      tight.bounds.push_back(b);
+    }
+    const TetOptimizeStats st = optimize_tets(bounded, w3, tight);
+    CAPTURE(seed);
+    CHECK(st.inverted_after == 0);
+    CHECK(st.moves > 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v) CHECK(tight.bounds[v].contains(bounded.points[v]));
+  }
+}
