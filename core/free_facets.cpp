@@ -126,26 +126,6 @@ void update_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const
 
 namespace {
 
-/// The part [t0, t1] of the segment a + t (b - a), t in [0, 1], inside the open box `box`: its
-/// length t1 - t0 as a share of the segment, or a negative number when it misses the box.
-template <int Dim>
-double share_in_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
-  double t0 = 0.0, t1 = 1.0;
-  for (int d = 0; d < Dim; ++d) {
-    const double dir = b[d] - a[d];
-    if (std::abs(dir) < 1e-300) {
-      if (a[d] <= box.lo[d] || a[d] >= box.hi[d]) return -1.0;
-      continue;
-    }
-    double s0 = (box.lo[d] - a[d]) / dir, s1 = (box.hi[d] - a[d]) / dir;
-    if (s0 > s1) std::swap(s0, s1);
-    t0 = std::max(t0, s0);
-    t1 = std::min(t1, s1);
-    if (t0 >= t1) return -1.0;
-  }
-  return t1 - t0;
-}
-
 /// The parameters [t0, t1] of the part of segment [a, b] in the open box `box`; t0 >= t1 when
 /// it misses the box.
 template <int Dim>
@@ -166,6 +146,22 @@ std::pair<double, double> interval_in_open_box(const Box<Dim>& box, const Point<
   return {t0, t1};
 }
 
+/// The length t1 - t0 of that part as a share of the segment, or a negative number when it
+/// misses the box.
+template <int Dim>
+double share_in_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
+  const auto [t0, t1] = interval_in_open_box(box, a, b);
+  return t0 < t1 ? t1 - t0 : -1.0;
+}
+
+/// The bounding box of segment [a, b]: the leaves it may meet are in it.
+template <int Dim> Box<Dim> segment_box(const Point<Dim>& a, const Point<Dim>& b) {
+  Box<Dim> sb = Box<Dim>::empty();
+  sb.expand(a);
+  sb.expand(b);
+  return sb;
+}
+
 /// Does the segment meet the open box `box`?
 template <int Dim>
 bool segment_meets_open_box(const Box<Dim>& box, const Point<Dim>& a, const Point<Dim>& b) {
@@ -177,10 +173,7 @@ bool segment_meets_open_box(const Box<Dim>& box, const Point<Dim>& a, const Poin
 template <int Dim>
 bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
                          double rel_tol) {
-  Box<Dim> sb = Box<Dim>::empty();
-  sb.expand(a);
-  sb.expand(b);
-  for (std::size_t i : leaves_in_box(t, sb)) {
+  for (std::size_t i : leaves_in_box(t, segment_box<Dim>(a, b))) {
     if (!keep[i]) continue;
     Box<Dim> box = geometry(t, t.leaf(i));
     const double shrink = rel_tol * (box.hi[0] - box.lo[0]);
@@ -194,11 +187,8 @@ bool segment_enters_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<
 template <int Dim>
 bool segment_enters_kept_region(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
                                 double rel_tol, double graze_length) {
-  Box<Dim> sb = Box<Dim>::empty();
-  sb.expand(a);
-  sb.expand(b);
   std::vector<std::size_t> nb;
-  for (std::size_t i : leaves_in_box(t, sb)) {
+  for (std::size_t i : leaves_in_box(t, segment_box<Dim>(a, b))) {
     if (!keep[i]) continue;
     const Box<Dim> cell = geometry(t, t.leaf(i));
     const double size = cell.hi[0] - cell.lo[0];
@@ -224,12 +214,9 @@ bool segment_enters_kept_region(const Orthtree<Dim>& t, const Flags& keep, const
 template <int Dim>
 double cells_along_kept(const Orthtree<Dim>& t, const Flags& keep, const Point<Dim>& a, const Point<Dim>& b,
                         double rel_tol) {
-  Box<Dim> sb = Box<Dim>::empty();
-  sb.expand(a);
-  sb.expand(b);
   std::vector<std::pair<double, double>> parts;
   double smallest = std::numeric_limits<double>::infinity();
-  for (std::size_t i : leaves_in_box(t, sb)) {
+  for (std::size_t i : leaves_in_box(t, segment_box<Dim>(a, b))) {
     if (!keep[i]) continue;
     Box<Dim> box = geometry(t, t.leaf(i));
     const double size = box.hi[0] - box.lo[0];
