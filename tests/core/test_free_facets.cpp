@@ -19,6 +19,17 @@ template <int Dim> bool same(const std::vector<FreeFacet<Dim>>& a, const std::ve
   return true;
 }
 
+/// The unit cube in 4^Dim leaves of size 0.25, the lower half along axis 0 kept (x < 0.5).
+template <int Dim> struct HalfKept {
+  Orthtree<Dim> t;
+  Flags keep;
+  HalfKept() {
+    for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
+    keep.resize(t.n_leaves());
+    for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  }
+};
+
 }  // namespace
 
 TEMPLATE_TEST_CASE_SIG("update_free_facets gives free_facets after the change", "[free_facets][property]", ((int Dim), Dim), 2,
@@ -71,11 +82,9 @@ TEMPLATE_TEST_CASE_SIG("free_facets skips only facets with kept leaves across", 
 
 TEMPLATE_TEST_CASE_SIG("segment_enters_kept_region: the graze allowance only at the region's boundary", "[free_facets]",
                        ((int Dim), Dim), 2, 3) {
-  // The unit cube in 4^Dim leaves of size 0.25, the lower half along axis 0 kept (x < 0.5).
-  Orthtree<Dim> t;
-  for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
-  Flags keep(t.n_leaves());
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  const HalfKept<Dim> h;
+  const Orthtree<Dim>& t = h.t;
+  const Flags& keep = h.keep;
   Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
   // Along the plane x = 0.25 between two kept leaves, 0.01 (0.04 of a leaf) off it: the face
   // is inside the region, so the segment enters it; each leaf alone is only grazed.
@@ -102,11 +111,9 @@ TEMPLATE_TEST_CASE_SIG("segment_enters_kept_region: the graze allowance only at 
 
 TEMPLATE_TEST_CASE_SIG("cells_along_kept: the run along the kept leaves in leaf sizes", "[free_facets]",
                        ((int Dim), Dim), 2, 3) {
-  // The unit cube in 4^Dim leaves of size 0.25, the lower half along axis 0 kept (x < 0.5).
-  Orthtree<Dim> t;
-  for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
-  Flags keep(t.n_leaves());
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  const HalfKept<Dim> h;
+  const Orthtree<Dim>& t = h.t;
+  const Flags& keep = h.keep;
   Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
   // On the region's boundary plane x = 0.5 from y 0.05 to 0.95: 0.9 = 3.6 leaf sizes along it.
   a[0] = b[0] = 0.5;
