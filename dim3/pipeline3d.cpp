@@ -1329,9 +1329,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     }
     n_prev_problems = problems.size();
     Flags flags;
-    std::vector<P3> places;
-    for (const Problem3& pr : problems) places.push_back(pr.where);
-    if (!at_fault.empty()) places = at_fault;
+    // The problems' places, or with opt.repair_at_cells the faults behind them.
+    std::vector<P3> places = at_fault;
+    if (places.empty())
+      for (const Problem3& pr : problems) places.push_back(pr.where);
     const bool stuck = last || worse || !mark_around<3>(tree, places, 1.5, max_level, flags);
     if (stuck && saved && saved->topology_right) {
       // The finer tree could not be built: the valid coarser mesh stands (with its volume

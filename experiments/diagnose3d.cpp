@@ -315,10 +315,10 @@ int main(int argc, char** argv) {
   opt.graze_region = bo.graze_region;
   opt.graze_length = bo.graze_length;
   opt.backward_along = bo.backward_along;
-  for (int i = 1; i < argc; ++i)
+  for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]) == "--accept-folds") opt.accept_valid_folds = true;
-  for (int i = 1; i < argc; ++i)
     if (std::string(argv[i]) == "--repair-at-cells") opt.repair_at_cells = true;
+  }
   for (int i = 1; i + 1 < argc; ++i) {
     if (std::string(argv[i]) == "--peel-rounds") opt.peel_rounds = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--untangle-reach") opt.untangle_reach = std::atof(argv[i + 1]);
