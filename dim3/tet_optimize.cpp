@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <span>
 
 #include <Eigen/LU>
@@ -190,6 +191,10 @@ struct Optimizer {
   double target_rank = 0.0;  ///< angle_rank of the target dihedral angle
   double tangent_rank = 0.0;  ///< angle_rank of opt.tangent_below_deg
   bool avx = has_avx();  ///< rank four lanes at a time in AVX registers
+  /// With untangle_only: the positive tetrahedra start at unranked_rank, not ranked
+  /// (tet_untangle_rank), until a move or relax (for a folded triangle's node) ranks them.
+  bool unranked = false;
+  static constexpr double unranked_rank = 1.0;  // above every rank (1 - cos^2(70.53 deg) = 8/9)
   /// One thread's working space for relax.
   struct alignas(64) Scratch {
     std::vector<MovingTet> local;  ///< relax's incident tetrahedra seen from its node
@@ -197,6 +202,7 @@ struct Optimizer {
     std::vector<MovingTetLanes<4>> quads;
     std::vector<MovingTetLanes<2>> pairs;
     std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
+    std::vector<std::int32_t> woken;  ///< the nodes this thread woke for the next sweep
     std::size_t moves = 0;
   };
 
@@ -461,10 +467,26 @@ struct Optimizer {
     const bool surf = is_surface(v);
     const bool guard = surf && !f_start.empty();
     double tets_worst = std::numeric_limits<double>::infinity();
-    for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
-      if (tet_q[incident[k]] < tets_worst) tets_worst = tet_q[incident[k]], worst_local = k - start[v];
+    const auto find_worst = [&] {
+      for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
+        if (tet_q[incident[k]] < tets_worst) tets_worst = tet_q[incident[k]], worst_local = k - start[v];
+    };
+    find_worst();
     const double f0 = std::min(tets_worst, guard ? faces_worst(v, x0, node_normal(v)) : 1e300);
     if (opt.untangle_only ? f0 > 0 : f0 >= target_rank) return false;
+    if (unranked && tets_worst > 0) {
+      // Only a folded interface triangle here: the worst tetrahedron (the first search
+      // direction) is the worst of positive ones, so those not ranked yet are ranked now. Not
+      // moved since the start (a move ranks them), they get the numbers the start gives them.
+      for (std::int32_t k = start[v]; k < start[v + 1]; ++k) {
+        double& q = tet_q[incident[k]];
+        if (q != unranked_rank) continue;
+        const Tet& t = tets[incident[k]];
+        q = tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+      }
+      tets_worst = std::numeric_limits<double>::infinity();
+      find_worst();
+    }
     double len = 0.0;
     const std::span<const std::int32_t> ring = neighbours(v);
     for (const std::int32_t u : ring) len += (mesh.points[u] - x0).norm();
@@ -587,6 +609,22 @@ double tet_search_rank(const P3& a, const P3& b, const P3& c, const P3& d) {
 
 double tet_search_rank_of_angle(double angle) { return angle_rank(angle); }
 
+double tet_untangle_rank(const P3& a, const P3& b, const P3& c, const P3& d) {
+  const P3 ab = b - a, ac = c - a, ad = d - a;
+  const double v6 = -ab.dot(ad.cross(ac));  // tet_search_rank's v6, the same operations
+  const double l2 = (ab.squaredNorm() + ac.squaredNorm() + ad.squaredNorm() + (c - b).squaredNorm() +
+                     (d - b).squaredNorm() + (d - c).squaredNorm()) /
+                    6.0;
+  // Mean ratio rho = sqrt2 v6 / l2^1.5 above 1e-3 (2 v6^2 > 1e-6 l2^3). At an edge e between
+  // faces i and j, sin(theta) = 6 V / (|e| h_i h_j) (h: the faces' heights over e), all three
+  // lengths at most the longest edge L, and L^2 <= 6 l2: sin(theta) >= v6 / (6 l2)^1.5 =
+  // rho / (6^1.5 sqrt2) > 4.8e-5 at every edge, so cos^2 < 1 - 2.3e-9 and tet_search_rank's
+  // 1 - c|c| is above 1e-9, far beyond its rounding (and no face has zero area while l2 is far
+  // above underflow).
+  if (v6 > 0 && l2 > 1e-100 && 2.0 * v6 * v6 > 1e-6 * l2 * l2 * l2) return 1.0;
+  return tet_search_rank(a, b, c, d);
+}
+
 double tet_search_quality(const P3& a, const P3& b, const P3& c, const P3& d) {
   const double r = mean_ratio_volume(a, b, c, d);
   if (!(r > 1e-9)) return std::min(r, 0.0) - 1.0;
@@ -644,14 +682,35 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
 
   TetOptimizeStats st;
   // Inverted tetrahedra and the smallest dihedral angle, from the ranks (one acos).
+  // (Not the angle with untangle_only and no ranks handed back: the positive ones are not ranked.)
+  // Ranges on the threads, four running minima in each (one was a chain of dependent minsd:
+  // 2.3 ms a call for 10^6 tetrahedra, two calls a pass, 66 untangling passes in elephant L4);
+  // a count and a minimum, the same whatever the order.
   const auto measure = [&](std::size_t& inverted, double& min_deg) {
-    inverted = 0;
+    std::atomic<std::size_t> n_inverted{0};
+    std::mutex lowest;
     double lo = std::numeric_limits<double>::infinity();
-    for (const double q : o.tet_q) {
-      inverted += q < 0 ? 1 : 0;
-      lo = std::min(lo, q);
-    }
-    min_deg = inverted > 0 ? 0.0 : o.tet_q.empty() ? 180.0 : rank_angle(lo) * 180.0 / pi;
+    for_each_range(o.tet_q.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
+      std::size_t k = 0;
+      double m[4];
+      std::fill(m, m + 4, std::numeric_limits<double>::infinity());
+      std::size_t i = begin;
+      for (; i + 4 <= end; i += 4)
+        for (int l = 0; l < 4; ++l) {
+          const double q = o.tet_q[i + l];
+          k += q < 0 ? 1 : 0;
+          m[l] = std::min(m[l], q);
+        }
+      for (; i < end; ++i) k += o.tet_q[i] < 0 ? 1 : 0, m[0] = std::min(m[0], o.tet_q[i]);
+      n_inverted += k;
+      const std::lock_guard<std::mutex> hold(lowest);
+      for (const double x : m) lo = std::min(lo, x);
+    });
+    const std::size_t inv = n_inverted.load();
+    inverted = inv;
+    min_deg = inv > 0 || (opt.untangle_only && !opt.ranks) ? 0.0
+              : o.tet_q.empty()                                  ? 180.0
+                                                                 : rank_angle(lo) * 180.0 / pi;
   };
   // Active nodes: those of a tetrahedron below the target; the set shrinks as nodes settle.
   const double target = opt.untangle_only ? 0.0 : opt.target_dihedral_deg * pi / 180.0;
@@ -664,6 +723,12 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     o.tet_q.swap(*opt.ranks);
   else
     o.tet_q.resize(o.tets.size());
+  // Untangling looks at the tetrahedra at or below rank 0 only (relax returns at once from a
+  // node whose tetrahedra are all above it; below it, the worst and the nearly worst are those
+  // at or below 0, exact): the others start at rank 1 (tet_untangle_rank), unless the ranks go
+  // back to the caller. Every such pass ranked all of them (elephant L4: 66 passes, 1.1 s).
+  const bool untangle_ranks = opt.untangle_only && !opt.ranks;
+  o.unranked = untangle_ranks;
   o.target_rank = angle_rank(target);
   o.tangent_rank = angle_rank(opt.tangent_below_deg * pi / 180.0);
   std::atomic<bool> some_active{false};
@@ -671,8 +736,8 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     bool here = false;
     for (std::size_t i = begin; i < end; ++i) {
       const Tet& t = o.tets[i];
-      const double q =
-          ranked ? o.tet_q[i] : tet_search_rank(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]], mesh.points[t[3]]);
+      const P3 &a = mesh.points[t[0]], &b = mesh.points[t[1]], &c = mesh.points[t[2]], &d = mesh.points[t[3]];
+      const double q = ranked ? o.tet_q[i] : untangle_ranks ? tet_untangle_rank(a, b, c, d) : tet_search_rank(a, b, c, d);
       o.tet_q[i] = q;
       if (opt.untangle_only ? q <= 0 : q < o.target_rank) {
         here = true;
@@ -728,13 +793,16 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
       for (const std::int32_t u : o.faces[o.f_incident[k]]) visit(u);
   };
   std::vector<Optimizer::Scratch> scratch(static_cast<std::size_t>(std::max(1, opt.n_threads)));
+  // A sweep's nodes: the active movable ones, ascending. The next sweep's are those a move
+  // woke (next[u] set), listed by the threads as they set them: few (1-6 k in an untangling
+  // sweep) are sorted, many are found by a scan of next, as every sweep did (30 sweeps a pass,
+  // 66 passes at elephant L4).
   std::vector<std::int32_t> nodes;
+  for (std::size_t v = 0; v < n; ++v)
+    if (active[v] && o.movable(static_cast<std::int32_t>(v))) nodes.push_back(static_cast<std::int32_t>(v));
+  std::vector<std::uint8_t>().swap(active);
   for (int sweep = 0; sweep < opt.max_sweeps; ++sweep) {
-    std::fill(next.begin(), next.end(), 0);
-    nodes.clear();
-    for (std::size_t v = 0; v < n; ++v)
-      if (active[v] && o.movable(static_cast<std::int32_t>(v))) nodes.push_back(static_cast<std::int32_t>(v));
-    for (Optimizer::Scratch& sc : scratch) sc.moves = 0;
+    for (Optimizer::Scratch& sc : scratch) sc.moves = 0, sc.woken.clear();
     o.list_neighbours(nodes);
     const OrderedSweep order(nodes, n, opt.n_threads, for_neighbours);
     order.run([&](std::int32_t v, int t) {
@@ -743,15 +811,32 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
       Optimizer::Scratch& sc = scratch[static_cast<std::size_t>(t)];
       if (!o.relax(v, sc)) return;
       ++sc.moves;
-      for (const std::int32_t u : o.neighbours(v)) mark(next[u], 1), mark(stale[u], 1);
-      next[v] = 1, stale[v] = 1;
+      // (Two threads may both list a node: the list is made unique.)
+      const auto wake = [&](std::int32_t u) {
+        if (std::atomic_ref<std::uint8_t>(next[u]).load(std::memory_order_relaxed)) return;
+        mark(next[u], 1);
+        sc.woken.push_back(u);
+      };
+      for (const std::int32_t u : o.neighbours(v)) wake(u), mark(stale[u], 1);
+      wake(v), stale[v] = 1;
     });
-    std::size_t moved = 0;
-    for (const Optimizer::Scratch& sc : scratch) moved += sc.moves;
+    std::size_t moved = 0, woken = 0;
+    for (const Optimizer::Scratch& sc : scratch) moved += sc.moves, woken += sc.woken.size();
     st.sweeps = sweep + 1;
     st.moves += moved;
     if (moved == 0) break;
-    active.swap(next);
+    nodes.clear();
+    if (woken <= n / 16) {
+      for (const Optimizer::Scratch& sc : scratch) nodes.insert(nodes.end(), sc.woken.begin(), sc.woken.end());
+      std::sort(nodes.begin(), nodes.end());
+      nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+      for (const std::int32_t v : nodes) next[v] = 0;
+      nodes.erase(std::remove_if(nodes.begin(), nodes.end(), [&](std::int32_t v) { return !o.movable(v); }), nodes.end());
+    } else {
+      for (std::size_t v = 0; v < n; ++v)
+        if (next[v] && o.movable(static_cast<std::int32_t>(v))) nodes.push_back(static_cast<std::int32_t>(v));
+      std::fill(next.begin(), next.end(), 0);
+    }
   }
   measure(st.inverted_after, st.min_dihedral_after_deg);
   st.folded_after = count_folded();

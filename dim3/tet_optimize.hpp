@@ -94,6 +94,8 @@ struct TetOptimizeStats {
   std::size_t moves = 0;
   std::size_t inverted_before = 0, inverted_after = 0;  ///< tetrahedra
   std::size_t folded_before = 0, folded_after = 0;      ///< interface triangles (with surface_normal)
+  /// The smallest dihedral angles; 0 with untangle_only (and no ranks), which does not rank
+  /// the positive tetrahedra.
   double min_dihedral_before_deg = 0.0, min_dihedral_after_deg = 0.0;
 };
 
@@ -106,6 +108,10 @@ double tet_search_quality(const Point<3>& a, const Point<3>& b, const Point<3>& 
 /// acos or roots for positive tetrahedra: 1 - c|c| in [0, 2], c the cosine of the smallest
 /// dihedral angle; inverted and flat ones as tet_search_quality (<= -1).
 double tet_search_rank(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
+
+/// tet_search_rank where it is 0 or below; 1 for the tetrahedra whose mean ratio is above 1e-3,
+/// whose tet_search_rank is above 1e-9 (what the untangling needs: which are at or below 0).
+double tet_untangle_rank(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d);
 
 /// tet_search_rank of a positive tetrahedron whose smallest dihedral angle is `angle` radians.
 double tet_search_rank_of_angle(double angle);

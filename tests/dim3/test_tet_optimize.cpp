@@ -79,6 +79,32 @@ TEST_CASE("tet_search_rank has the sign of tet_search_quality and its order", "[
   });
 }
 
+TEST_CASE("tet_untangle_rank is tet_search_rank at or below 0, and 1 only above 1e-9", "[tet_optimize][property]") {
+  // Random tetrahedra and slivers: a random triangle and a fourth point at a height of
+  // 10^-k of its size over a random point of its plane, either side, at random scales.
+  test::prop("untangle rank", 2000, [] {
+    const auto p = *rc::gen::container<std::vector<P3>>(5, gen_point());
+    const int k = *rc::gen::inRange(0, 16);
+    const int scale = *rc::gen::inRange(-6, 7);
+    const bool sliver = *rc::gen::arbitrary<bool>();
+    const P3 n = (p[1] - p[0]).cross(p[2] - p[0]);
+    RC_PRE(n.norm() > 1e-6);
+    const P3 d = sliver ? P3(p[3] + (p[4][0] > 0 ? 1.0 : -1.0) * std::pow(10.0, -k) * n / n.norm() -
+                             (p[3] - p[0]).dot(n) / n.squaredNorm() * n)
+                        : p[3];
+    const double f = std::pow(10.0, scale);
+    const P3 a = f * p[0], b = f * p[1], c = f * p[2], e = f * d;
+    const double rank = tet_search_rank(a, b, c, e), fast = tet_untangle_rank(a, b, c, e);
+    RC_ASSERT((fast == 1.0 && rank > 1e-9) || fast == rank);
+    if (rank <= 0) RC_ASSERT(fast == rank);
+  });
+  const P3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), d(0, 0, 1);
+  CHECK(tet_untangle_rank(a, b, c, d) == 1.0);  // well shaped: not ranked
+  CHECK(tet_untangle_rank(a, c, b, d) == tet_search_rank(a, c, b, d));  // inverted: its rank
+  const P3 flat(0.3, 0.3, 1e-12);  // positive, mean ratio below 1e-3: ranked
+  CHECK(tet_untangle_rank(a, b, c, flat) == tet_search_rank(a, b, c, flat));
+}
+
 TEST_CASE("tet_search_rank of known tetrahedra", "[tet_optimize]") {
   const P3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0), d(0, 0, 1);
   // The corner tetrahedron: smallest dihedral angle acos(1/sqrt3) (at the slanted face's edges).
@@ -290,6 +316,47 @@ TEST_CASE("ranks handed between sweeps and edge removal are a pass's own, and ch
       // The sequence did something to hand on.
       CHECK(moves > 0);
       CHECK(removed > 0);
+    }
+  }
+}
+
+TEST_CASE("untangling without ranking the positive tetrahedra moves the nodes ranking them all moves", "[tet_optimize]") {
+  // untangle_only ranks only the tetrahedra at or below 0 (tet_untangle_rank) unless ranks are
+  // handed back, which ranks them all: the same moves either way, on 1 and 2 threads.
+  for (const unsigned seed : {3u, 4u}) {
+    const int n = 7;
+    Mesh<3> start = jittered_cube(0.3, seed, n);
+    // Every fifth inner node pushed 0.8 away: its tetrahedra turn over.
+    int pushed = 0;
+    for (std::size_t v = 0; v < start.points.size(); ++v)
+      if (start.points[v].minCoeff() > 0 && start.points[v].maxCoeff() < n - 1 && v % 5 == 0)
+        start.points[v] += P3(0.8, -0.5, 0.6), ++pushed;
+    REQUIRE(pushed > 5);
+    std::vector<BoundaryLocation> where(start.points.size());
+    TetOptimizeOptions to;
+    to.untangle_only = true;
+    to.max_sweeps = 30;
+    to.fixed.assign(start.points.size(), 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v)
+      to.fixed[v] = start.points[v].minCoeff() == 0.0 || start.points[v].maxCoeff() == n - 1.0 ? 1 : 0;
+    for (const int threads : {1, 2}) {
+      Mesh<3> plain = start, ranked = start;
+      std::vector<BoundaryLocation> where_plain = where, where_ranked = where;
+      TetOptimizeOptions to_plain = to, to_ranked = to;
+      to_plain.n_threads = to_ranked.n_threads = threads;
+      std::vector<double> ranks;
+      to_ranked.ranks = &ranks;
+      const TetOptimizeStats a = optimize_tets(plain, where_plain, to_plain);
+      const TetOptimizeStats b = optimize_tets(ranked, where_ranked, to_ranked);
+      CAPTURE(seed, threads, a.inverted_before, a.inverted_after);
+      CHECK(a.inverted_before > 0);
+      CHECK(a.inverted_after < a.inverted_before);
+      CHECK(a.moves > 0);
+      CHECK(a.moves == b.moves);
+      CHECK(a.sweeps == b.sweeps);
+      CHECK(a.inverted_before == b.inverted_before);
+      CHECK(a.inverted_after == b.inverted_after);
+      CHECK(plain.points == ranked.points);
     }
   }
 }
