@@ -1221,6 +1221,12 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         continue;
     }
     if (problems.empty()) {
+      // Set when the whole mesh passed the validator below (folds, or the Escobar pass): its
+      // geometric checks include surface_contacts' on the whole mesh (hanging and duplicate nodes,
+      // facets used twice; the duplicate tolerance is relative to the box of the nodes, larger
+      // for the whole mesh than for the tetrahedra at the surface), so those are not run again
+      // (elephant L4: the kept tree comes from the Escobar pass).
+      bool validated = false;
       improve_quality(s, oc.complex, fe, opt, surface_point, surface_normal, r, say);
       clock.lap("smoothing");
       add_problems(fe.mesh, inverted_elements(fe.mesh, opt.n_threads),
@@ -1233,6 +1239,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         const ValidationReport v = validate(fe.mesh, surface_validation(s));
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
+        validated = v.valid;
         if (!v.valid) problems = std::move(*folds_pending);
       } else if (problems.empty() && before_escobar) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
@@ -1240,6 +1247,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         // what the max-min untangling alone would have done, refine around its problems. Not
         // after the validation above, whose checks include these.
         const ValidationReport v = validation(fe.mesh);
+        validated = v.valid;
         if (!v.valid) {
           say("untangling (Escobar objective): the mesh does not conform; refining instead");
           problems = std::move(*before_escobar);
@@ -1258,7 +1266,8 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           }
         }
       }
-      if (problems.empty()) {
+      if (validated) clock.lap("validation");
+      if (problems.empty() && !validated) {
         // The checks above see inverted tetrahedra and folds, not a surface mesh that touches
         // itself: two sheets meeting on a concave feature line can leave a node of one on an
         // edge of the other (measured: regressions/voxel-hanging-node-concave-edge.off, level
