@@ -1130,8 +1130,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
     if (problems.empty()) {
       say("finite elements: templates");
       // Feature snaps that invert an element are undone, then the templates are redone.
+      // The rounds move the complex's nodes only: the interior octants' part is built once.
+      InteriorTets interior_tets;
       for (int round = 0;; ++round) {
-        fe = tetrahedralize(tree, oc.complex, surface_point, opt.n_threads);
+        fe = tetrahedralize(tree, oc.complex, surface_point, opt.n_threads, &interior_tets);
         const std::vector<Box<3>> bounds =
             opt.untangle_reach > 0 ? move_bounds(tree, oc.complex, fe, opt.untangle_reach) : std::vector<Box<3>>{};
         {

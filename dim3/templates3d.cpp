@@ -225,7 +225,8 @@ void triangulate_square(const std::array<LP, 4>& q, std::uint32_t len,
   for (std::size_t k = 0; k < n_ring; ++k) out.push_back({c, ring[k], ring[(k + 1) % n_ring]});
 }
 
-TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const SurfacePointFn& surface_point, int n_threads) {
+TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const SurfacePointFn& surface_point, int n_threads,
+                       InteriorTets* kept) {
   Builder b{t, oc, surface_point, {}, {}, {}, {}};
   b.index_lattice();
   b.out.mesh.points = oc.points;
@@ -246,59 +247,76 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     std::vector<LP> fans;                 // the octants' fan centres, octant by octant
     std::vector<std::int32_t> fan_ids;    // their node ids (pass 2)
   };
-  std::vector<std::uint16_t> n_tris(n_int), n_fans(n_int), n_tets(n_int);
+  // With `kept` filled for this tree: the interior part from there (passes 1-3 skipped).
+  const bool reuse = kept && kept->filled && kept->n_complex_points == oc.points.size() && kept->n_interior == n_int;
+  std::vector<std::uint16_t> n_tris, n_fans, n_tets;
   std::vector<Range> ranges;
-  std::mutex ranges_mutex;
-  for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t end) {
-    Range r;
-    r.begin = begin, r.end = end;
-    // 12 face triangles an octant without hanging nodes, more with: room for 14 a octant, so
-    // that the list seldom grows by doubling (each growth a fresh copy, faulted in page by page).
-    reserve_huge(r.tris, 14 * (end - begin));
-    std::vector<Tri> cell_tris;
-    std::vector<LP> cell_fans;
-    const auto fan_placeholder = [&](const LP& p) {
-      const auto it = std::find(cell_fans.begin(), cell_fans.end(), p);
-      if (it != cell_fans.end()) return -1 - static_cast<std::int32_t>(it - cell_fans.begin());
-      cell_fans.push_back(p);
-      return -static_cast<std::int32_t>(cell_fans.size());
-    };
-    const auto lattice_node = [&](const LP& p) { return b.lattice_node(p); };
-    for (std::size_t k = begin; k < end; ++k) {
-      const Cell<3>& c = t.leaf(oc.interior[k]);
-      cell_tris.clear();
-      cell_fans.clear();
-      for (int f = 0; f < Cube<3>::n_faces; ++f) {
-        const auto& fc = FaceCorners<3>::corners[f];
-        triangulate_square({corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])}, length(c), lattice_node,
-                           fan_placeholder, cell_tris);
+  std::vector<std::int32_t> centroid;
+  std::vector<std::size_t> tet_start;
+  if (reuse) {
+    b.out.mesh.points.insert(b.out.mesh.points.end(), kept->points.begin(), kept->points.end());
+    b.out.where.resize(b.out.mesh.points.size(), BoundaryLocation{});  // as add_point gives them
+    b.fan = kept->fan;
+    b.out.n_dropped_degenerate = kept->n_dropped_degenerate;
+  } else {
+    n_tris.resize(n_int), n_fans.resize(n_int), n_tets.resize(n_int);
+    std::mutex ranges_mutex;
+    for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t end) {
+      Range r;
+      r.begin = begin, r.end = end;
+      // 12 face triangles an octant without hanging nodes, more with: room for 14 a octant, so
+      // that the list seldom grows by doubling (each growth a fresh copy, faulted in page by page).
+      reserve_huge(r.tris, 14 * (end - begin));
+      std::vector<Tri> cell_tris;
+      std::vector<LP> cell_fans;
+      const auto fan_placeholder = [&](const LP& p) {
+        const auto it = std::find(cell_fans.begin(), cell_fans.end(), p);
+        if (it != cell_fans.end()) return -1 - static_cast<std::int32_t>(it - cell_fans.begin());
+        cell_fans.push_back(p);
+        return -static_cast<std::int32_t>(cell_fans.size());
+      };
+      const auto lattice_node = [&](const LP& p) { return b.lattice_node(p); };
+      for (std::size_t k = begin; k < end; ++k) {
+        const Cell<3>& c = t.leaf(oc.interior[k]);
+        cell_tris.clear();
+        cell_fans.clear();
+        for (int f = 0; f < Cube<3>::n_faces; ++f) {
+          const auto& fc = FaceCorners<3>::corners[f];
+          triangulate_square({corner(c, fc[0]), corner(c, fc[1]), corner(c, fc[2]), corner(c, fc[3])}, length(c), lattice_node,
+                             fan_placeholder, cell_tris);
+        }
+        MESH_ASSERT(cell_tris.size() < 65536, "too many face triangles in one octant");
+        n_tris[k] = static_cast<std::uint16_t>(cell_tris.size());
+        n_fans[k] = static_cast<std::uint16_t>(cell_fans.size());
+        std::uint16_t good = 0;
+        for (const Tri& q : cell_tris) good += (q[0] != q[1] && q[1] != q[2] && q[2] != q[0]) ? 1 : 0;
+        n_tets[k] = good;
+        r.tris.insert(r.tris.end(), cell_tris.begin(), cell_tris.end());
+        r.fans.insert(r.fans.end(), cell_fans.begin(), cell_fans.end());
       }
-      MESH_ASSERT(cell_tris.size() < 65536, "too many face triangles in one octant");
-      n_tris[k] = static_cast<std::uint16_t>(cell_tris.size());
-      n_fans[k] = static_cast<std::uint16_t>(cell_fans.size());
-      std::uint16_t good = 0;
-      for (const Tri& q : cell_tris) good += (q[0] != q[1] && q[1] != q[2] && q[2] != q[0]) ? 1 : 0;
-      n_tets[k] = good;
-      r.tris.insert(r.tris.end(), cell_tris.begin(), cell_tris.end());
-      r.fans.insert(r.fans.end(), cell_fans.begin(), cell_fans.end());
-    }
-    const std::lock_guard<std::mutex> lock(ranges_mutex);
-    ranges.push_back(std::move(r));
-  });
-  std::sort(ranges.begin(), ranges.end(), [](const Range& x, const Range& y) { return x.begin < y.begin; });
-  std::vector<std::int32_t> centroid(n_int);
-  std::vector<std::size_t> tet_start(n_int + 1, 0);
-  for (Range& r : ranges) {
-    r.fan_ids.resize(r.fans.size());
-    std::size_t fan = 0;
-    for (std::size_t k = r.begin; k < r.end; ++k) {
-      for (std::size_t i = 0; i < n_fans[k]; ++i, ++fan) r.fan_ids[fan] = b.fan_node(r.fans[fan]);
-      centroid[k] = b.add_point(geometry(t, t.leaf(oc.interior[k])).center());
-      tet_start[k + 1] = tet_start[k] + n_tets[k];
-      b.out.n_dropped_degenerate += n_tris[k] - n_tets[k];
+      const std::lock_guard<std::mutex> lock(ranges_mutex);
+      ranges.push_back(std::move(r));
+    });
+    std::sort(ranges.begin(), ranges.end(), [](const Range& x, const Range& y) { return x.begin < y.begin; });
+    centroid.resize(n_int);
+    tet_start.assign(n_int + 1, 0);
+    for (Range& r : ranges) {
+      r.fan_ids.resize(r.fans.size());
+      std::size_t fan = 0;
+      for (std::size_t k = r.begin; k < r.end; ++k) {
+        for (std::size_t i = 0; i < n_fans[k]; ++i, ++fan) r.fan_ids[fan] = b.fan_node(r.fans[fan]);
+        centroid[k] = b.add_point(geometry(t, t.leaf(oc.interior[k])).center());
+        tet_start[k + 1] = tet_start[k] + n_tets[k];
+        b.out.n_dropped_degenerate += n_tris[k] - n_tets[k];
+      }
     }
   }
-  const std::size_t n_int_tets = tet_start[n_int];
+  const std::size_t n_int_tets = reuse ? kept->level.size() : tet_start[n_int];
+  const std::size_t n_interior_points = b.out.mesh.points.size();  // the complex's and the interior part's
+  if (kept && !reuse) {
+    kept->fan = b.fan;
+    kept->n_dropped_degenerate = b.out.n_dropped_degenerate;
+  }
   Mesh<3>& m = b.out.mesh;
 
   // Boundary octants.
@@ -425,29 +443,45 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   m.solid.offset = {};
   reserve_huge(m.solid.offset, n_all_tets + 1);
   m.solid.offset.resize(n_all_tets + 1);
-  // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
-  for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
-    const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
-    MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
-    const Range& r = *it;
-    std::size_t tri = 0, fan = 0;
-    for (std::size_t k = r.begin; k < r.end; ++k) {
-      const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
-      std::size_t e = tet_start[k];
-      const std::uint8_t level = t.leaf(oc.interior[k]).level;
-      for (std::size_t i = 0; i < n_tris[k]; ++i) {
-        const Tri& q = r.tris[tri + i];
-        if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
-        VertexId* v = m.solid.node.data() + 4 * e;
-        v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
-        m.level[e] = level;
-        b.out.cell[e] = static_cast<std::int32_t>(k);
-        ++e;
+  if (reuse) {
+    std::copy(kept->node.begin(), kept->node.end(), m.solid.node.begin());
+    std::copy(kept->level.begin(), kept->level.end(), m.level.begin());
+    std::copy(kept->cell.begin(), kept->cell.end(), b.out.cell.begin());
+  } else {
+    // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
+    for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
+      const auto it = std::lower_bound(ranges.begin(), ranges.end(), begin, [](const Range& x, std::size_t v) { return x.begin < v; });
+      MESH_ASSERT(it != ranges.end() && it->begin == begin, "tetrahedralize: the ranges of pass 1");
+      const Range& r = *it;
+      std::size_t tri = 0, fan = 0;
+      for (std::size_t k = r.begin; k < r.end; ++k) {
+        const auto id = [&](std::int32_t v) { return v >= 0 ? v : r.fan_ids[fan + static_cast<std::size_t>(-1 - v)]; };
+        std::size_t e = tet_start[k];
+        const std::uint8_t level = t.leaf(oc.interior[k]).level;
+        for (std::size_t i = 0; i < n_tris[k]; ++i) {
+          const Tri& q = r.tris[tri + i];
+          if (q[0] == q[1] || q[1] == q[2] || q[2] == q[0]) continue;
+          VertexId* v = m.solid.node.data() + 4 * e;
+          v[0] = VertexId{id(q[0])}, v[1] = VertexId{id(q[2])}, v[2] = VertexId{id(q[1])}, v[3] = VertexId{centroid[k]};
+          m.level[e] = level;
+          b.out.cell[e] = static_cast<std::int32_t>(k);
+          ++e;
+        }
+        tri += n_tris[k];
+        fan += n_fans[k];
       }
-      tri += n_tris[k];
-      fan += n_fans[k];
-    }
-  });
+    });
+  }
+  if (kept && !reuse) {
+    kept->points.assign(m.points.begin() + static_cast<std::ptrdiff_t>(oc.points.size()),
+                        m.points.begin() + static_cast<std::ptrdiff_t>(n_interior_points));
+    kept->node.assign(m.solid.node.begin(), m.solid.node.begin() + static_cast<std::ptrdiff_t>(4 * n_int_tets));
+    kept->level.assign(m.level.begin(), m.level.begin() + static_cast<std::ptrdiff_t>(n_int_tets));
+    kept->cell.assign(b.out.cell.begin(), b.out.cell.begin() + static_cast<std::ptrdiff_t>(n_int_tets));
+    kept->n_complex_points = oc.points.size();
+    kept->n_interior = n_int;
+    kept->filled = true;
+  }
   for (std::size_t e = 0; e <= n_all_tets; ++e) m.solid.offset[e] = static_cast<std::int32_t>(4 * e);
   ranges.clear();
   ranges.shrink_to_fit();

@@ -20,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <vector>
 
 #include "core/mesh.hpp"
@@ -48,11 +49,28 @@ struct TetMesh {
   std::size_t n_fins_cancelled = 0;      ///< pairs of back-to-back triangles of one cell, dropped
 };
 
+/// tetrahedralize's interior part: the interior octants' tetrahedra and the nodes they add
+/// (fan centres and centroids, after the complex's nodes). It depends on the tree, the interior
+/// octants and the lattice, not on where the complex's nodes are, so a call on the same tree
+/// and complex with moved nodes (the repair's untangling rounds) takes it from here.
+struct InteriorTets {
+  bool filled = false;
+  std::size_t n_complex_points = 0, n_interior = 0;  ///< what it was made for (checked)
+  std::vector<P3> points;                              ///< the nodes it adds, in order
+  std::vector<VertexId> node;                          ///< its tetrahedra, four nodes each
+  std::vector<std::uint8_t> level;
+  std::vector<std::int32_t> cell;
+  std::map<std::uint64_t, std::int32_t> fan;  ///< fan centre nodes by lattice point key
+  std::size_t n_dropped_degenerate = 0;
+};
+
 /// Node ids 0..complex.points.size()-1 of the result are the complex's nodes.
 /// The interior octants' tetrahedra are built on n_threads threads; the result is the same for
-/// every count.
+/// every count. With `kept`: its interior part when filled for this complex's tree (the same
+/// numbers of nodes and interior octants; the caller vouches for the rest), else built and kept
+/// there; the same result either way.
 TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& complex, const SurfacePointFn& surface_point,
-                       int n_threads = 1);
+                       int n_threads = 1, InteriorTets* kept = nullptr);
 
 /// The triangles (outward, CCW seen from outside the cell) of a lattice square face with
 /// corners `q` counter-clockwise seen from outside, by the face rule above. `lattice_node`

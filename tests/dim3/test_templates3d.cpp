@@ -152,3 +152,42 @@ TEST_CASE("templates are conforming on random 2:1 octrees", "[templates3d][prope
     }
   });
 }
+
+TEST_CASE("the interior part kept between calls gives the mesh a fresh call gives", "[templates3d][property]") {
+  // The repair's rounds move the complex's projections and build again on the same tree: the
+  // second call takes the interior octants' part from the first. Its result must be the fresh
+  // call's, array for array, on any thread count.
+  test::prop("kept interior part", 20, [] {
+    std::vector<std::vector<bool>> picks;
+    for (int r = 0; r < *rc::gen::inRange(1, 3); ++r)
+      picks.push_back(*rc::gen::container<std::vector<bool>>(*rc::gen::inRange(1, 23), rc::gen::arbitrary<bool>()));
+    const Orthtree<3> t = random_tree(2, picks);
+    Flags in;
+    OctantComplex oc = box_complex(t, 0.25, 0.75, 1.5, in);
+    const int n_threads = *rc::gen::inRange(1, 4);
+    InteriorTets kept;
+    const TetMesh first = tetrahedralize(t, oc, {}, n_threads, &kept);
+    RC_ASSERT(kept.filled);
+    RC_ASSERT(first.mesh.points == tetrahedralize(t, oc, {}, n_threads).mesh.points);
+    // Projections pushed further out, each by its own factor.
+    const std::int32_t n_lattice = oc.n_lattice();
+    const P3 centre = P3::Constant(0.5);
+    for (std::size_t v = static_cast<std::size_t>(n_lattice); v < oc.points.size(); ++v)
+      oc.points[v] = centre + (1.0 + 0.05 * static_cast<double>(v % 7)) * (oc.points[v] - centre);
+    const TetMesh again = tetrahedralize(t, oc, {}, n_threads, &kept);
+    const TetMesh fresh = tetrahedralize(t, oc, {}, n_threads);
+    RC_ASSERT(again.mesh.points == fresh.mesh.points);
+    RC_ASSERT(again.where.size() == fresh.where.size());
+    RC_ASSERT(again.mesh.solid.node == fresh.mesh.solid.node);
+    RC_ASSERT(again.mesh.solid.offset == fresh.mesh.solid.offset);
+    RC_ASSERT(again.mesh.solid.type == fresh.mesh.solid.type);
+    RC_ASSERT(again.mesh.level == fresh.mesh.level);
+    RC_ASSERT(again.mesh.from_boundary_cell == fresh.mesh.from_boundary_cell);
+    RC_ASSERT(again.cell == fresh.cell);
+    RC_ASSERT(again.mesh.interface.node == fresh.mesh.interface.node);
+    RC_ASSERT(again.n_dropped_degenerate == fresh.n_dropped_degenerate);
+    RC_ASSERT(again.n_fins_cancelled == fresh.n_fins_cancelled);
+    // And the moved projections did change the mesh (the test compares something).
+    RC_ASSERT(!(again.mesh.points == first.mesh.points));
+  });
+}
