@@ -187,6 +187,12 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep = null
 /// classify must be monotone in the box (see classify.cpp).
 template <int Dim>
 std::vector<Side> classify(const Orthtree<Dim>& t, const Boundary<Dim>& b, int n_threads = 1);
+/// classify(t, b) for a refinement t of `before` (the same root box, every leaf of t inside a
+/// leaf of `before`), whose answers are before_sides: only the leaves below before's Partial
+/// leaves are asked (a repair refines a few places). Any other t is classified from scratch.
+template <int Dim>
+std::vector<Side> classify_refined(const Orthtree<Dim>& t, const Orthtree<Dim>& before, const std::vector<Side>& before_sides,
+                                   const Boundary<Dim>& b, int n_threads = 1);
 /// Slow twin: b.classify of every leaf's own box.
 template <int Dim> std::vector<Side> classify_ref(const Orthtree<Dim>& t, const Boundary<Dim>& b);
 

@@ -80,3 +80,31 @@ TEMPLATE_TEST_CASE_SIG("classification on random balls", "[orthtree][classify][p
     RC_ASSERT(classify_ref(tree, ball) == sides);
   });
 }
+
+TEMPLATE_TEST_CASE_SIG("classifying a refined tree from the answers before it", "[orthtree][classify][property]",
+                       ((int Dim), Dim), 2, 3) {
+  test::prop("classify_refined is classify", 40, [] {
+    Point<Dim> c;
+    for (int d = 0; d < Dim; ++d) c[d] = *rc::gen::inRange(-500, 501) / 1000.0;
+    const double r = *rc::gen::inRange(50, 900) / 1000.0;
+    const test::Ball<Dim> ball(c, r, Dim == 2 ? 6 : 4);
+    const Box<Dim> domain{Point<Dim>::Constant(-1.0), Point<Dim>::Constant(1.0)};
+    const auto before = subdivide_by_control<Dim>(domain, [&](const Box<Dim>& box) { return ball.control_level(box); });
+    const auto before_sides = classify(before, ball, 1);
+    // A repair's refinement: some leaves (IN, OUT and Partial ones) split, then 2:1 balance.
+    const auto pick = *rc::gen::container<std::vector<bool>>(*rc::gen::inRange(1, 17), rc::gen::arbitrary<bool>());
+    Flags flags(before.n_leaves(), 0);
+    std::size_t n_split = 0;
+    for (std::size_t i = 0; i < before.n_leaves(); ++i)
+      if (pick[i % pick.size()] && before.leaf(i).level < (Dim == 2 ? 9 : 6)) flags[i] = 1, ++n_split;
+    RC_PRE(n_split > 0);
+    const auto after = balance_2to1(refine(before, flags), BalanceKind::Full);
+    const auto expected = classify(after, ball, 1);
+    const int n_threads = *rc::gen::inRange(1, 4);
+    RC_ASSERT(classify_refined(after, before, before_sides, ball, n_threads) == expected);
+    // Not a refinement (coarser leaves): classified from scratch, the same answers.
+    RC_ASSERT(classify_refined(before, after, expected, ball, n_threads) == before_sides);
+    // Answers that do not fit the tree before: from scratch too.
+    RC_ASSERT(classify_refined(after, before, std::vector<Side>{}, ball, n_threads) == expected);
+  });
+}
