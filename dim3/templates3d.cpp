@@ -92,6 +92,15 @@ double min_angle(const P3& a, const P3& b, const P3& c) {
   return std::min({ang(a, b, c), ang(b, c, a), ang(c, a, b)});
 }
 
+/// FNV-1a over the first n tetrahedra's node ids, levels and cells (InteriorTets::hash).
+std::uint64_t interior_hash(const Mesh<3>& m, const std::vector<std::int32_t>& cell, std::size_t n) {
+  std::uint64_t h = 1469598103934665603ull;
+  const auto mix = [&h](std::uint64_t x) { h = (h ^ x) * 1099511628211ull; };
+  for (std::size_t i = 0; i < 4 * n; ++i) mix(static_cast<std::uint32_t>(m.solid.node[i].v));
+  for (std::size_t e = 0; e < n; ++e) mix(static_cast<std::uint64_t>(m.level[e]) << 32 | static_cast<std::uint32_t>(cell[e]));
+  return h;
+}
+
 struct Builder {
   const Orthtree<3>& tree;
   const OctantComplex& oc;
@@ -226,7 +235,7 @@ void triangulate_square(const std::array<LP, 4>& q, std::uint32_t len,
 }
 
 TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const SurfacePointFn& surface_point, int n_threads,
-                       InteriorTets* kept) {
+                       InteriorTets* kept, const TetMesh* last) {
   Builder b{t, oc, surface_point, {}, {}, {}, {}};
   b.index_lattice();
   b.out.mesh.points = oc.points;
@@ -247,18 +256,24 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     std::vector<LP> fans;                 // the octants' fan centres, octant by octant
     std::vector<std::int32_t> fan_ids;    // their node ids (pass 2)
   };
-  // With `kept` filled for this tree: the interior part from there (passes 1-3 skipped).
-  const bool reuse = kept && kept->filled && kept->n_complex_points == oc.points.size() && kept->n_interior == n_int;
+  // With `kept` filled for this tree and `last` beginning with its tetrahedra: the interior
+  // part from there (passes 1-3 skipped).
+  const bool reuse = kept && kept->filled && kept->n_complex_points == oc.points.size() && kept->n_interior == n_int &&
+                     last && last->mesh.solid.size() >= kept->n_tets && last->mesh.level.size() >= kept->n_tets &&
+                     last->cell.size() >= kept->n_tets && interior_hash(last->mesh, last->cell, kept->n_tets) == kept->hash;
   std::vector<std::uint16_t> n_tris, n_fans, n_tets;
   std::vector<Range> ranges;
   std::vector<std::int32_t> centroid;
   std::vector<std::size_t> tet_start;
   if (reuse) {
-    b.out.mesh.points.insert(b.out.mesh.points.end(), kept->points.begin(), kept->points.end());
-    b.out.where.resize(b.out.mesh.points.size(), BoundaryLocation{});  // as add_point gives them
-    b.fan = kept->fan;
+    // The nodes as pass 2 makes them (add_point of the same positions).
+    for (const std::uint64_t o : kept->origin)
+      b.add_point((o & InteriorTets::centroid_tag) ? geometry(t, t.leaf(oc.interior[o & ~InteriorTets::centroid_tag])).center()
+                                                   : position(t, point_from_key<3>(o)));
+    b.fan = std::map<std::uint64_t, std::int32_t>(kept->fan.begin(), kept->fan.end());
     b.out.n_dropped_degenerate = kept->n_dropped_degenerate;
   } else {
+    if (kept) kept->filled = false, kept->origin.clear();
     n_tris.resize(n_int), n_fans.resize(n_int), n_tets.resize(n_int);
     std::mutex ranges_mutex;
     for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t end) {
@@ -304,17 +319,21 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
       r.fan_ids.resize(r.fans.size());
       std::size_t fan = 0;
       for (std::size_t k = r.begin; k < r.end; ++k) {
-        for (std::size_t i = 0; i < n_fans[k]; ++i, ++fan) r.fan_ids[fan] = b.fan_node(r.fans[fan]);
+        for (std::size_t i = 0; i < n_fans[k]; ++i, ++fan) {
+          const std::size_t n_before = b.out.mesh.points.size();
+          r.fan_ids[fan] = b.fan_node(r.fans[fan]);
+          if (kept && b.out.mesh.points.size() > n_before) kept->origin.push_back(point_key<3>(r.fans[fan]));
+        }
         centroid[k] = b.add_point(geometry(t, t.leaf(oc.interior[k])).center());
+        if (kept) kept->origin.push_back(InteriorTets::centroid_tag | k);
         tet_start[k + 1] = tet_start[k] + n_tets[k];
         b.out.n_dropped_degenerate += n_tris[k] - n_tets[k];
       }
     }
   }
-  const std::size_t n_int_tets = reuse ? kept->level.size() : tet_start[n_int];
-  const std::size_t n_interior_points = b.out.mesh.points.size();  // the complex's and the interior part's
+  const std::size_t n_int_tets = reuse ? kept->n_tets : tet_start[n_int];
   if (kept && !reuse) {
-    kept->fan = b.fan;
+    kept->fan.assign(b.fan.begin(), b.fan.end());
     kept->n_dropped_degenerate = b.out.n_dropped_degenerate;
   }
   Mesh<3>& m = b.out.mesh;
@@ -444,9 +463,10 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   reserve_huge(m.solid.offset, n_all_tets + 1);
   m.solid.offset.resize(n_all_tets + 1);
   if (reuse) {
-    std::copy(kept->node.begin(), kept->node.end(), m.solid.node.begin());
-    std::copy(kept->level.begin(), kept->level.end(), m.level.begin());
-    std::copy(kept->cell.begin(), kept->cell.end(), b.out.cell.begin());
+    const auto n = static_cast<std::ptrdiff_t>(n_int_tets);
+    std::copy(last->mesh.solid.node.begin(), last->mesh.solid.node.begin() + 4 * n, m.solid.node.begin());
+    std::copy(last->mesh.level.begin(), last->mesh.level.begin() + n, m.level.begin());
+    std::copy(last->cell.begin(), last->cell.begin() + n, b.out.cell.begin());
   } else {
     // The same ranges as pass 1 (for_each_range splits [0, n_int) the same way every time).
     for_each_range(n_int, n_threads, [&](std::size_t begin, std::size_t) {
@@ -473,11 +493,8 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
     });
   }
   if (kept && !reuse) {
-    kept->points.assign(m.points.begin() + static_cast<std::ptrdiff_t>(oc.points.size()),
-                        m.points.begin() + static_cast<std::ptrdiff_t>(n_interior_points));
-    kept->node.assign(m.solid.node.begin(), m.solid.node.begin() + static_cast<std::ptrdiff_t>(4 * n_int_tets));
-    kept->level.assign(m.level.begin(), m.level.begin() + static_cast<std::ptrdiff_t>(n_int_tets));
-    kept->cell.assign(b.out.cell.begin(), b.out.cell.begin() + static_cast<std::ptrdiff_t>(n_int_tets));
+    kept->n_tets = n_int_tets;
+    kept->hash = interior_hash(m, b.out.cell, n_int_tets);
     kept->n_complex_points = oc.points.size();
     kept->n_interior = n_int;
     kept->filled = true;
