@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <optional>
 #include <span>
@@ -743,12 +744,48 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   return r;
 }
 
+template <int Dim> std::uint64_t content_hash(const Mesh<Dim>& mesh) {
+  // FNV-1a in four lanes over 32-bit words (one chain of dependent multiplies is a cycle-bound
+  // 4 ns a word), each array's size first.
+  std::uint64_t h[4] = {1469598103934665603ull, 1469598103934665603ull ^ 1, 1469598103934665603ull ^ 2,
+                        1469598103934665603ull ^ 3};
+  const auto mix = [](std::uint64_t& x, std::uint64_t v) { x = (x ^ v) * 1099511628211ull; };
+  const auto add = [&](const auto& v) {
+    using T = typename std::decay_t<decltype(v)>::value_type;
+    mix(h[0], v.size());
+    const std::size_t n_words = v.size() * sizeof(T) / 4;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(v.data());
+    std::size_t w = 0;
+    for (; w + 4 <= n_words; w += 4)
+      for (int k = 0; k < 4; ++k) {
+        std::uint32_t x;
+        std::memcpy(&x, bytes + 4 * (w + static_cast<std::size_t>(k)), 4);
+        mix(h[k], x);
+      }
+    for (std::size_t b = 4 * w; b < v.size() * sizeof(T); ++b) mix(h[0], bytes[b]);
+  };
+  static_assert(sizeof(Point<Dim>) == Dim * sizeof(double), "points are packed doubles");
+  add(mesh.points);
+  for (const Elements* els : {&mesh.solid, &mesh.interface}) {
+    add(els->type);
+    add(els->offset);
+    add(els->node);
+  }
+  add(mesh.level);
+  add(mesh.from_boundary_cell);
+  std::uint64_t out = 0;
+  for (const std::uint64_t x : h) mix(out, x);
+  return out;
+}
+
 template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options) {
   return validate<Dim>(mesh, options).valid;
 }
 
 template ValidationReport validate<2>(const Mesh<2>&, const ValidateOptions<2>&);
 template ValidationReport validate<3>(const Mesh<3>&, const ValidateOptions<3>&);
+template std::uint64_t content_hash<2>(const Mesh<2>&);
+template std::uint64_t content_hash<3>(const Mesh<3>&);
 template bool is_valid<2>(const Mesh<2>&, const ValidateOptions<2>&);
 template bool is_valid<3>(const Mesh<3>&, const ValidateOptions<3>&);
 template long euler_characteristic<2>(const Mesh<2>&, int);

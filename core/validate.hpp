@@ -74,6 +74,11 @@ struct ValidationReport {
 };
 
 template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});
+
+/// A hash of everything validate reads of a mesh: the points' bits, the solid's and the
+/// interface's elements, the attribute arrays. A report made for a mesh applies to a mesh with
+/// the same hash (a caller that validated it already hands the report on with the hash).
+template <int Dim> std::uint64_t content_hash(const Mesh<Dim>& mesh);
 template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});
 
 /// Euler characteristic of the solid elements alone: V - E + F (2D), V - E + F - C (3D),

@@ -9,6 +9,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
@@ -840,12 +841,16 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   try {
     Result3d t = mesh3d_facing(s, thin, thin_effort, progress);
     t.n_octants_built = r.n_octants_built + thin_effort.used;
-    const ValidationReport v = validate(t.fe.mesh, surface_validation(s));
+    ValidateOptions<3> vo = surface_validation(s);
+    vo.n_threads = opt.n_threads;  // the same report on any count
+    const ValidationReport v = validate(t.fe.mesh, vo);
     const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);
     if (progress)
       progress("thin parts: the mesh is " + std::string(v.valid ? "valid" : "not valid (" + v.summary() + ")") +
                ", volume error " + std::to_string(100 * t_error) + "%");
     if (v.valid && t_error < error) {
+      t.validation = v;
+      t.validation_hash = content_hash(t.fe.mesh);
       t.thickness_refined = true;
       t.level_raised = r.level_raised;
       std::vector<StageTime3> times = std::move(r.times);
@@ -1239,6 +1244,9 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
           refine_surface_octants(false, euler))
         continue;
     }
+    // The validator's report with the surface's checks, when the mesh passed it below (handed
+    // on with the mesh: Result3d::validation).
+    std::optional<ValidationReport> report;
     if (problems.empty()) {
       // Set when the whole mesh passed the validator below (folds, or the Escobar pass): its
       // geometric checks include surface_contacts' on the whole mesh (hanging and duplicate nodes,
@@ -1259,15 +1267,24 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         validated = v.valid;
+        if (v.valid) report = v;
         if (!v.valid) problems = std::move(*folds_pending);
       } else if (problems.empty() && before_escobar) {
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
         // what the max-min untangling alone would have done, refine around its problems. Not
-        // after the validation above, whose checks include these.
-        const ValidationReport v = validation(fe.mesh);
-        validated = v.valid;
-        if (!v.valid) {
+        // after the validation above, whose checks include these. With the surface's checks (the
+        // interface nodes' distance, the Euler characteristic), so that the report can go on with
+        // the mesh; conforming is all the others passing, as the validation without them found.
+        ValidateOptions<3> vo = surface_validation(s);
+        vo.n_threads = opt.n_threads;
+        const ValidationReport v = validate(fe.mesh, vo);
+        const bool conforms = v.bad_elements == 0 && v.inverted == 0 && v.nonconforming_facets == 0 &&
+                              v.hanging_nodes == 0 && v.interface_mismatch == 0 && v.unused_nodes == 0 &&
+                              v.duplicate_nodes == 0 && v.attribute_mismatch == 0;
+        validated = conforms;
+        if (conforms) report = v;
+        if (!conforms) {
           say("untangling (Escobar objective): the mesh does not conform; refining instead");
           problems = std::move(*before_escobar);
           at_fault = std::move(at_fault_before_escobar);
@@ -1277,7 +1294,8 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             // with the faults behind those tetrahedra.
             std::vector<Problem3> sites;
             for (const auto& site : v.sites)
-              if (site.node >= 0) sites.push_back({fe.mesh.points[static_cast<std::size_t>(site.node)], site.kind});
+              if (site.node >= 0 && std::string_view(site.kind) != "an interface node is off the boundary")
+                sites.push_back({fe.mesh.points[static_cast<std::size_t>(site.node)], site.kind});
             if (!sites.empty()) {
               for (const Problem3& p : sites) at_fault.push_back(p.where);
               problems = std::move(sites);
@@ -1316,6 +1334,10 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         clock.lap("hex-dominant");
       }
       r.stats = oc.stats;
+      if (report && !opt.hex_dominant) {
+        r.validation = std::move(report);
+        r.validation_hash = content_hash(fe.mesh);
+      }
       r.fe = std::move(fe);
       r.interior = std::move(in);
       r.tree = std::move(tree);

@@ -8,6 +8,7 @@
 // the maximum level.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -215,6 +216,11 @@ struct Result3d {
   std::size_t n_concave_swaps = 0;  ///< of the edges removed, concave surface edges (EdgeRemovalOptions::concave_below_deg)
   HexDominantStats hex;              ///< with opt.hex_dominant
   std::vector<StageTime3> times;
+  /// validate(fe.mesh, surface_validation(s)) where the pipeline made it of the mesh it returns
+  /// (after the Escobar pass, with folds pending, the thickness retry), with content_hash of
+  /// that mesh: a caller finding the same hash has the report without validating again.
+  std::optional<ValidationReport> validation;
+  std::uint64_t validation_hash = 0;
 };
 
 using Progress3 = std::function<void(const std::string&)>;

@@ -380,3 +380,36 @@ TEMPLATE_TEST_CASE_SIG("the report is the same on 1, 2 and 3 threads", "[validat
     CHECK(r.euler == one.euler);
   }
 }
+
+TEMPLATE_TEST_CASE_SIG("content_hash changes with anything validate reads", "[validate]", ((int Dim), Dim), 2, 3) {
+  // A report handed on with a mesh's hash applies only to that mesh: every array validate reads
+  // changes the hash when one value in it changes (one ulp of a coordinate, one node id, one
+  // attribute, one element more), and a copy hashes the same.
+  const Mesh<Dim> mesh = test::grid_mesh<Dim>(3, true);
+  REQUIRE(!mesh.interface.empty());
+  const std::uint64_t h = content_hash(mesh);
+  CHECK(content_hash(Mesh<Dim>(mesh)) == h);
+  Mesh<Dim> m = mesh;
+  m.points[5][1] = std::nextafter(m.points[5][1], 10.0);
+  CHECK(content_hash(m) != h);
+  m = mesh;
+  std::swap(m.solid.node[0], m.solid.node[1]);
+  CHECK(content_hash(m) != h);
+  m = mesh;
+  std::swap(m.interface.node[0], m.interface.node[1]);
+  CHECK(content_hash(m) != h);
+  m = mesh;
+  m.level.assign(m.solid.size(), 0);
+  const std::uint64_t with_levels = content_hash(m);
+  CHECK(with_levels != h);
+  m.level[m.solid.size() - 1] = 1;
+  CHECK(content_hash(m) != with_levels);
+  m = mesh;
+  m.from_boundary_cell.assign(m.solid.size(), 0);
+  const std::uint64_t with_flags = content_hash(m);
+  m.from_boundary_cell[0] = 1;
+  CHECK(content_hash(m) != with_flags);
+  m = mesh;
+  m.add_point(Point<Dim>::Zero());
+  CHECK(content_hash(m) != h);
+}
