@@ -71,6 +71,12 @@ struct ValidationReport {
 
   /// One line per nonzero count, then the problems.
   std::string summary() const;
+  /// Valid but for the surface's checks (the interface nodes' distance, the Euler
+  /// characteristic): what `valid` is without those options.
+  bool conforms() const {
+    return bad_elements == 0 && inverted == 0 && nonconforming_facets == 0 && hanging_nodes == 0 &&
+           interface_mismatch == 0 && unused_nodes == 0 && duplicate_nodes == 0 && attribute_mismatch == 0;
+  }
 };
 
 template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options = {});

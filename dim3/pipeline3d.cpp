@@ -1273,15 +1273,13 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         // Positive tetrahedra can still overlap where the surface mesh covers a strip twice
         // (measured: regressions/torus-12x8-feature-snap-inverted.off, hanging nodes): then do
         // what the max-min untangling alone would have done, refine around its problems. Not
-        // after the validation above, whose checks include these. With the surface's checks (the
-        // interface nodes' distance, the Euler characteristic), so that the report can go on with
-        // the mesh; conforming is all the others passing, as the validation without them found.
+        // after the validation above, whose checks include these. With the surface's checks, so
+        // that the report can go on with the mesh; whether it conforms is the validation without
+        // them (ValidationReport::conforms).
         ValidateOptions<3> vo = surface_validation(s);
         vo.n_threads = opt.n_threads;
         const ValidationReport v = validate(fe.mesh, vo);
-        const bool conforms = v.bad_elements == 0 && v.inverted == 0 && v.nonconforming_facets == 0 &&
-                              v.hanging_nodes == 0 && v.interface_mismatch == 0 && v.unused_nodes == 0 &&
-                              v.duplicate_nodes == 0 && v.attribute_mismatch == 0;
+        const bool conforms = v.conforms();
         validated = conforms;
         if (conforms) report = v;
         if (!conforms) {

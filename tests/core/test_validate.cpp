@@ -29,6 +29,13 @@ TEMPLATE_TEST_CASE_SIG("structured grids are valid", "[validate]", ((int Dim), D
 
     opt.expected_euler = 0;
     CHECK_FALSE(is_valid(mesh, opt));
+    CHECK(validate(mesh, opt).conforms());  // the surface's checks alone fail
+    opt.expected_euler = 1;
+    opt.boundary_tolerance = -1.0;  // every interface node "off the boundary"
+    const ValidationReport off = validate(mesh, opt);
+    CHECK_FALSE(off.valid);
+    CHECK(off.off_boundary_nodes > 0);
+    CHECK(off.conforms());
   }
 }
 
@@ -41,6 +48,7 @@ TEMPLATE_TEST_CASE_SIG("an inverted element is detected", "[validate]", ((int Di
     const ValidationReport r = validate(mesh);
     INFO(r.summary());
     CHECK_FALSE(r.valid);
+    CHECK_FALSE(r.conforms());
     CHECK(r.inverted > 0);
     CHECK(r.nonconforming_facets == 0);
     CHECK(r.interface_mismatch == 0);
