@@ -149,8 +149,7 @@ int run(const std::vector<std::string>& argv) {
   std::future<dim3::Fidelity3d> measuring = std::async(launch, [&] {
     return dim3::measure_fidelity(opt.hex_dominant ? triangulated_interface(mesh) : mesh, surface);
   });
-  ValidateOptions<3> vo = dim3::surface_validation(surface);
-  vo.n_threads = opt.n_threads;
+  const ValidateOptions<3> vo = dim3::surface_validation(surface, opt.n_threads);
   // The pipeline's report of this mesh with these checks, when it made one (meshes from the
   // Escobar pass, with folds, from the thickness retry) and the mesh is still that one (its
   // content hash): the same report without validating twice (elephant L4: 1.4 s a thread).

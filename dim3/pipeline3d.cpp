@@ -634,8 +634,9 @@ Result3d mesh3d_buffer(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 }  // namespace
 
-ValidateOptions<3> surface_validation(const SurfaceBoundary& s) {
+ValidateOptions<3> surface_validation(const SurfaceBoundary& s, int n_threads) {
   ValidateOptions<3> vo;
+  vo.n_threads = n_threads;
   if (s.euler_characteristic() % 2 == 0) vo.expected_euler = s.euler_characteristic() / 2;
   vo.boundary_distance = [&s](const Point<3>& p) { return s.closest_point(p).distance; };
   vo.boundary_tolerance = 1e-10 * s.bounding_box().extent().norm();
@@ -841,9 +842,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   try {
     Result3d t = mesh3d_facing(s, thin, thin_effort, progress);
     t.n_octants_built = r.n_octants_built + thin_effort.used;
-    ValidateOptions<3> vo = surface_validation(s);
-    vo.n_threads = opt.n_threads;  // the same report on any count
-    const ValidationReport v = validate(t.fe.mesh, vo);
+    const ValidationReport v = validate(t.fe.mesh, surface_validation(s, opt.n_threads));
     const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);
     if (progress)
       progress("thin parts: the mesh is " + std::string(v.valid ? "valid" : "not valid (" + v.summary() + ")") +
@@ -1263,7 +1262,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         // Folded interface triangles where the surface's normals at their nodes disagree (the
         // two sheets of a lip thinner than the octants): the fold test has no reference there.
         // The mesh stands if it is valid (conforming, interface = boundary faces on the surface).
-        const ValidationReport v = validate(fe.mesh, surface_validation(s));
+        const ValidationReport v = validate(fe.mesh, surface_validation(s, opt.n_threads));
         say("folded interface triangles: " + std::to_string(folds_pending->size()) + " after untangling; the mesh is " +
             (v.valid ? "valid" : "not valid (" + v.summary() + ")"));
         validated = v.valid;
@@ -1276,9 +1275,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
         // after the validation above, whose checks include these. With the surface's checks, so
         // that the report can go on with the mesh; whether it conforms is the validation without
         // them (ValidationReport::conforms).
-        ValidateOptions<3> vo = surface_validation(s);
-        vo.n_threads = opt.n_threads;
-        const ValidationReport v = validate(fe.mesh, vo);
+        const ValidationReport v = validate(fe.mesh, surface_validation(s, opt.n_threads));
         const bool conforms = v.conforms();
         validated = conforms;
         if (conforms) report = v;

@@ -245,6 +245,7 @@ Options3d facing_try_options(const Options3d& opt);
 /// What a mesh of `s` is validated against (DESIGN.md, "Validity"): the solid's Euler
 /// characteristic is half the surface's (when that is even), and interface nodes lie on the
 /// surface within 1e-10 of its diagonal. The options refer to `s`, which must outlive them.
-ValidateOptions<3> surface_validation(const SurfaceBoundary& s);
+/// On n_threads threads (the same report on any count).
+ValidateOptions<3> surface_validation(const SurfaceBoundary& s, int n_threads = 1);
 
 }  // namespace febemesh::dim3
