@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <utility>
+
 #include "core/free_facets.hpp"
 #include "core/cell_arbitrary.hpp"
 #include "property.hpp"
@@ -27,6 +29,14 @@ template <int Dim> struct HalfKept {
     for (int k = 0; k < 2; ++k) t = refine(t, Flags(t.n_leaves(), 1));
     keep.resize(t.n_leaves());
     for (std::size_t i = 0; i < t.n_leaves(); ++i) keep[i] = geometry(t, t.leaf(i)).center()[0] < 0.5 ? 1 : 0;
+  }
+  /// The segment along y from 0.05 to 0.95 on the plane x = `x` (0.3 in the other coordinates).
+  static std::pair<Point<Dim>, Point<Dim>> along_y(double x) {
+    Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
+    a[0] = b[0] = x;
+    a[1] = 0.05;
+    b[1] = 0.95;
+    return {a, b};
   }
 };
 
@@ -85,12 +95,9 @@ TEMPLATE_TEST_CASE_SIG("segment_enters_kept_region: the graze allowance only at 
   const HalfKept<Dim> h;
   const Orthtree<Dim>& t = h.t;
   const Flags& keep = h.keep;
-  Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
   // Along the plane x = 0.25 between two kept leaves, 0.01 (0.04 of a leaf) off it: the face
   // is inside the region, so the segment enters it; each leaf alone is only grazed.
-  a[0] = b[0] = 0.26;
-  a[1] = 0.05;
-  b[1] = 0.95;
+  auto [a, b] = HalfKept<Dim>::along_y(0.26);
   CHECK_FALSE(segment_enters_kept(t, keep, a, b, 0.05));
   CHECK(segment_enters_kept_region(t, keep, a, b, 0.05));
   // Along the region's boundary x = 0.5, 0.01 inside: grazing, allowed by both; but it runs
@@ -114,11 +121,8 @@ TEMPLATE_TEST_CASE_SIG("cells_along_kept: the run along the kept leaves in leaf 
   const HalfKept<Dim> h;
   const Orthtree<Dim>& t = h.t;
   const Flags& keep = h.keep;
-  Point<Dim> a = Point<Dim>::Constant(0.3), b = a;
   // On the region's boundary plane x = 0.5 from y 0.05 to 0.95: 0.9 = 3.6 leaf sizes along it.
-  a[0] = b[0] = 0.5;
-  a[1] = 0.05;
-  b[1] = 0.95;
+  auto [a, b] = HalfKept<Dim>::along_y(0.5);
   CHECK(cells_along_kept(t, keep, a, b, 0.05) == Approx(3.6));
   // 0.1 outside it (0.4 of a leaf, more than the allowance): none.
   a[0] = b[0] = 0.6;

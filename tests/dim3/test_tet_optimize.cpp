@@ -54,6 +54,15 @@ Mesh<3> jittered_cube(double jitter, unsigned seed, int n = 5) {
   return m;
 }
 
+/// 1 at the nodes on the faces of the cube [0, side]^3 (jittered_cube's boundary, which stays
+/// put: no surface projection here), else 0: TetOptimizeOptions::fixed.
+std::vector<std::uint8_t> cube_faces_fixed(const Mesh<3>& m, double side) {
+  std::vector<std::uint8_t> fixed(m.points.size(), 0);
+  for (std::size_t v = 0; v < m.points.size(); ++v)
+    fixed[v] = m.points[v].minCoeff() == 0.0 || m.points[v].maxCoeff() == side ? 1 : 0;
+  return fixed;
+}
+
 double min_dihedral(const Mesh<3>& m) {
   double lo = 180.0;
   for (std::size_t e = 0; e < m.solid.size(); ++e) {
@@ -123,12 +132,7 @@ TEST_CASE("optimize_tets raises the worst dihedral angle, inverts nothing, is re
     std::vector<BoundaryLocation> where(m.points.size());
     TetOptimizeOptions opt;
     opt.max_sweeps = 16;
-    // The cube's boundary nodes stay put (no surface projection here).
-    opt.fixed.assign(m.points.size(), 0);
-    for (std::size_t v = 0; v < m.points.size(); ++v) {
-      const P3& p = m.points[v];
-      opt.fixed[v] = p.minCoeff() == 0.0 || p.maxCoeff() == 4.0 ? 1 : 0;
-    }
+    opt.fixed = cube_faces_fixed(m, 4.0);
     Mesh<3> again = m;
     std::vector<BoundaryLocation> where2 = where;
     const TetOptimizeStats st = optimize_tets(m, where, opt);
@@ -274,9 +278,7 @@ TEST_CASE("ranks handed between sweeps and edge removal are a pass's own, and ch
     std::vector<BoundaryLocation> where(start.points.size());
     TetOptimizeOptions to;
     to.max_sweeps = 6;
-    to.fixed.assign(start.points.size(), 0);
-    for (std::size_t v = 0; v < start.points.size(); ++v)
-      to.fixed[v] = start.points[v].minCoeff() == 0.0 || start.points[v].maxCoeff() == n - 1.0 ? 1 : 0;
+    to.fixed = cube_faces_fixed(start, n - 1.0);
     EdgeRemovalOptions eo;
     eo.below_deg = 30.0;
     eo.contract_below_deg = 20.0;
@@ -336,9 +338,7 @@ TEST_CASE("untangling without ranking the positive tetrahedra moves the nodes ra
     TetOptimizeOptions to;
     to.untangle_only = true;
     to.max_sweeps = 30;
-    to.fixed.assign(start.points.size(), 0);
-    for (std::size_t v = 0; v < start.points.size(); ++v)
-      to.fixed[v] = start.points[v].minCoeff() == 0.0 || start.points[v].maxCoeff() == n - 1.0 ? 1 : 0;
+    to.fixed = cube_faces_fixed(start, n - 1.0);
     for (const int threads : {1, 2}) {
       Mesh<3> plain = start, ranked = start;
       std::vector<BoundaryLocation> where_plain = where, where_ranked = where;
@@ -367,11 +367,7 @@ TEST_CASE("optimize_tets keeps each node in its bounds box; empty boxes bound no
     std::vector<BoundaryLocation> where(start.points.size());
     TetOptimizeOptions opt;
     opt.max_sweeps = 16;
-    opt.fixed.assign(start.points.size(), 0);
-    for (std::size_t v = 0; v < start.points.size(); ++v) {
-      const P3& p = start.points[v];
-      opt.fixed[v] = p.minCoeff() == 0.0 || p.maxCoeff() == 4.0 ? 1 : 0;
-    }
+    opt.fixed = cube_faces_fixed(start, 4.0);
     // Unbounded, the optimiser moves nodes further than 0.02.
     Mesh<3> free_mesh = start;
     std::vector<BoundaryLocation> w1 = where;
