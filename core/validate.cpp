@@ -14,6 +14,7 @@
 #include <sstream>
 #include <type_traits>
 
+#include "core/fnv_lanes.hpp"
 #include "core/incidence_csr.hpp"
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
@@ -743,24 +744,20 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
 }
 
 template <int Dim> std::uint64_t content_hash(const Mesh<Dim>& mesh) {
-  // FNV-1a in four lanes over 32-bit words (one chain of dependent multiplies is a cycle-bound
-  // 4 ns a word), each array's size first.
-  std::uint64_t h[4] = {1469598103934665603ull, 1469598103934665603ull ^ 1, 1469598103934665603ull ^ 2,
-                        1469598103934665603ull ^ 3};
-  const auto mix = [](std::uint64_t& x, std::uint64_t v) { x = (x ^ v) * 1099511628211ull; };
-  const auto add = [&](const auto& v) {
+  FnvLanes h;
+  // Each array's size, then its bytes as 32-bit words (the bytes of a last partial word one by one).
+  const auto add = [&h](const auto& v) {
     using T = typename std::decay_t<decltype(v)>::value_type;
-    mix(h[0], v.size());
-    const std::size_t n_words = v.size() * sizeof(T) / 4;
+    h.add(v.size());
+    const std::size_t n_bytes = v.size() * sizeof(T);
     const auto* bytes = reinterpret_cast<const unsigned char*>(v.data());
-    std::size_t w = 0;
-    for (; w + 4 <= n_words; w += 4)
-      for (int k = 0; k < 4; ++k) {
-        std::uint32_t x;
-        std::memcpy(&x, bytes + 4 * (w + static_cast<std::size_t>(k)), 4);
-        mix(h[k], x);
-      }
-    for (std::size_t b = 4 * w; b < v.size() * sizeof(T); ++b) mix(h[0], bytes[b]);
+    std::size_t b = 0;
+    for (; b + 4 <= n_bytes; b += 4) {
+      std::uint32_t x;
+      std::memcpy(&x, bytes + b, 4);
+      h.add(x);
+    }
+    for (; b < n_bytes; ++b) h.add(bytes[b]);
   };
   static_assert(sizeof(Point<Dim>) == Dim * sizeof(double), "points are packed doubles");
   add(mesh.points);
@@ -771,9 +768,7 @@ template <int Dim> std::uint64_t content_hash(const Mesh<Dim>& mesh) {
   }
   add(mesh.level);
   add(mesh.from_boundary_cell);
-  std::uint64_t out = 0;
-  for (const std::uint64_t x : h) mix(out, x);
-  return out;
+  return h.value();
 }
 
 template <int Dim> bool is_valid(const Mesh<Dim>& mesh, const ValidateOptions<Dim>& options) {

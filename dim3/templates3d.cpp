@@ -8,6 +8,7 @@
 
 #include "core/cube_faces.hpp"
 #include "core/error.hpp"
+#include "core/fnv_lanes.hpp"
 #include "core/huge_pages.hpp"
 #include "core/parallel_ranges.hpp"
 
@@ -92,20 +93,12 @@ double min_angle(const P3& a, const P3& b, const P3& c) {
   return std::min({ang(a, b, c), ang(b, c, a), ang(c, a, b)});
 }
 
-/// FNV-1a over the first n tetrahedra's node ids, levels and cells (InteriorTets::hash), in four
-/// interleaved lanes (one chain of dependent multiplies was 8 ms a call at fandisk L5, two calls
-/// a round).
+/// A hash of the first n tetrahedra's node ids, levels and cells (InteriorTets::hash).
 std::uint64_t interior_hash(const Mesh<3>& m, const std::vector<std::int32_t>& cell, std::size_t n) {
-  std::uint64_t h[4] = {1469598103934665603ull, 1469598103934665603ull ^ 1, 1469598103934665603ull ^ 2,
-                        1469598103934665603ull ^ 3};
-  const auto mix = [](std::uint64_t& x, std::uint64_t v) { x = (x ^ v) * 1099511628211ull; };
-  const VertexId* v = m.solid.node.data();
-  for (std::size_t e = 0; e < n; ++e)
-    for (int k = 0; k < 4; ++k) mix(h[k], static_cast<std::uint32_t>(v[4 * e + k].v));
-  for (std::size_t e = 0; e < n; ++e) mix(h[e & 3], static_cast<std::uint64_t>(m.level[e]) << 32 | static_cast<std::uint32_t>(cell[e]));
-  std::uint64_t out = 0;
-  for (const std::uint64_t x : h) mix(out, x);
-  return out;
+  FnvLanes h;
+  for (std::size_t i = 0; i < 4 * n; ++i) h.add(static_cast<std::uint32_t>(m.solid.node[i].v));
+  for (std::size_t e = 0; e < n; ++e) h.add(static_cast<std::uint64_t>(m.level[e]) << 32 | static_cast<std::uint32_t>(cell[e]));
+  return h.value();
 }
 
 struct Builder {
