@@ -6,12 +6,14 @@
 #include <fstream>
 #include <future>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "cli/args.hpp"
 #include "cli/command.hpp"
+#include "cli/progress.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "core/process_stats.hpp"
@@ -112,9 +114,7 @@ int run(const std::vector<std::string>& argv) {
   const bool quiet = args.has("--quiet");
 
   const auto start = std::chrono::steady_clock::now();
-  auto progress = [&](const std::string& s) {
-    if (!quiet) std::cerr << "mesh2d: " << s << "\n";
-  };
+  const Progress progress("mesh2d", quiet);
   progress("reading " + input);
   RunInfo info;
   const auto since = [](std::chrono::steady_clock::time_point t0) {
@@ -181,10 +181,9 @@ int run(const std::vector<std::string>& argv) {
     if (!rep) throw InputError(dir.file("report.json").string() + ": cannot write");
   }
   dir.commit();
-  if (!quiet) {
-    std::cerr << "mesh2d: " << r.fe.mesh.solid.size() << " FE elements, " << r.fe.mesh.interface.size()
-              << " BE elements, " << r.fe.mesh.points.size() << " nodes in " << info.total_seconds << " s\n";
-  }
+  progress(std::to_string(r.fe.mesh.solid.size()) + " FE elements, " + std::to_string(r.fe.mesh.interface.size()) +
+           " BE elements, " + std::to_string(r.fe.mesh.points.size()) + " nodes in " +
+           (std::ostringstream() << info.total_seconds).str() + " s");
   std::cout << fs::path(out).string() << "\n";
   return exit_ok;
 }

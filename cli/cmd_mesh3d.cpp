@@ -14,6 +14,7 @@
 
 #include "cli/args.hpp"
 #include "cli/command.hpp"
+#include "cli/progress.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "core/quality.hpp"
@@ -112,9 +113,7 @@ int run(const std::vector<std::string>& argv) {
   opt.hex_dominant = elements == "hex";
   const MshEncoding encoding = args.has("--binary") ? MshEncoding::Binary : MshEncoding::Ascii;
   const bool quiet = args.has("--quiet");
-  const auto progress = [&](const std::string& s) {
-    if (!quiet) std::cerr << "mesh3d: " << s << "\n";
-  };
+  const Progress progress("mesh3d", quiet);
 
   const auto t0 = std::chrono::steady_clock::now();
   progress("reading " + input);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
@@ -95,6 +96,28 @@ TEST_CASE("mesh2d's report counts the stages whether or not it kept them for the
   // One boundary quadrant a free edge of the interior quadrants.
   CHECK(c["boundary_quadrants"] == dropped["boundary_quadrants"]["free_edges"]);
   CHECK(c["boundary_quadrants"].get<std::size_t>() > 0);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("mesh2d's progress lines carry the seconds since the start, never decreasing", "[cli][mesh2d]") {
+  const auto dir = scratch("progress");
+  std::filesystem::remove_all(dir);
+  const Run r = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 6 --threads 1");
+  INFO(r.output);
+  REQUIRE(r.status == 0);
+  const std::regex stamped(R"(^mesh2d: \[ *([0-9]+\.[0-9]) s\] \S.*$)");
+  std::istringstream lines(r.output);
+  int n = 0;
+  double last = 0.0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("mesh2d: ", 0) != 0) continue;
+    std::smatch m;
+    REQUIRE(std::regex_match(line, m, stamped));
+    CHECK(std::stod(m[1]) >= last);
+    last = std::stod(m[1]);
+    ++n;
+  }
+  CHECK(n >= 5);  // reading, the stages, writing
   std::filesystem::remove_all(dir);
 }
 
