@@ -1,6 +1,7 @@
 // moving_tet: the lanes' rank equals the scalar MovingTet::rank (its slow twin) bit for bit on
-// every lane it does not hand back, and hands back only lanes off the common case; two lanes
-// (SSE2), and four compiled for AVX when the CPU has it (as the optimiser runs them).
+// every lane, inverted, flat and degenerate tetrahedra included, and hands back (NaN) only lanes
+// whose scalar rank is NaN; two lanes (SSE2), and four compiled for AVX when the CPU has it (as
+// the optimiser runs them).
 
 #include <catch2/catch.hpp>
 
@@ -35,7 +36,11 @@ struct Rng {
 };
 
 struct Tally {
-  int common = 0, odd = 0, mismatched = 0;
+  int common = 0;      ///< lanes ranked above 0
+  int off_common = 0;  ///< lanes ranked at or below 0 (inverted, flat, degenerate), not handed back
+  int no_length = 0;   ///< of them, lanes whose edges are all zero (rank -2)
+  int odd = 0;         ///< lanes handed back (NaN)
+  int mismatched = 0;
 };
 
 /// Random tetrahedra at several scales, with flat, near-flat, repeated and inverted ones, and
@@ -56,6 +61,7 @@ template <int N, class Ranks> Tally compare_lanes(int rounds, Ranks&& ranks) {
         case 0: p[3] = p[1] + 0.5 * (p[2] - p[1]); break;                  // flat opposite face
         case 1: p[2] = p[1]; break;                                         // repeated node
         case 2: p[3] = p[0] + (p[1] - p[0]) + 1e-9 * (p[2] - p[0]); break;  // near-flat
+        case 3: p[1] = p[2] = p[3] = p[0]; break;                           // one point (l2 = 0 at p[v])
         default: break;
       }
       const std::int32_t v = (round / 2 + l) % 4;
@@ -72,9 +78,10 @@ template <int N, class Ranks> Tally compare_lanes(int rounds, Ranks&& ranks) {
         const double want = (same ? m[0] : m[l]).rank(P3(x[0][l], x[1][l], x[2][l]));
         if (std::isnan(out[l])) {
           ++tally.odd;
-          if (!(want <= 0.0 || std::isnan(want))) ++tally.mismatched;  // only inverted, flat, degenerate
+          if (!std::isnan(want)) ++tally.mismatched;  // handed back only where the scalar rank is NaN
         } else {
-          ++tally.common;
+          ++(out[l] > 0.0 ? tally.common : tally.off_common);
+          if (out[l] == -2.0) ++tally.no_length;
           if (bits(out[l]) != bits(want)) ++tally.mismatched;
         }
       }
@@ -106,7 +113,8 @@ TEST_CASE("MovingTetLanes<2>::rank equals MovingTet::rank bit for bit", "[tet_op
                                              const double* z, double* out) { lanes.rank(x, y, z, out); });
   CHECK(t.mismatched == 0);
   CHECK(t.common > 50000);
-  CHECK(t.odd > 10000);
+  CHECK(t.off_common > 10000);
+  CHECK(t.no_length > 100);
 }
 
 TEST_CASE("MovingTetLanes<4>::rank equals MovingTet::rank bit for bit, with AVX and without", "[tet_optimize]") {
@@ -115,10 +123,12 @@ TEST_CASE("MovingTetLanes<4>::rank equals MovingTet::rank bit for bit, with AVX 
   const Tally t = compare_lanes<4>(20000, plain);
   CHECK(t.mismatched == 0);
   CHECK(t.common > 50000);
-  CHECK(t.odd > 10000);
+  CHECK(t.off_common > 10000);
+  CHECK(t.no_length > 100);
   if (has_avx()) {
     const Tally a = compare_lanes<4>(20000, ranks_avx);
     CHECK(a.mismatched == 0);
     CHECK(a.common == t.common);
+    CHECK(a.off_common == t.off_common);
   }
 }
