@@ -9,13 +9,13 @@
 #include <mutex>
 #include <span>
 
-#include <Eigen/LU>
 
 #include "core/error.hpp"
 #include "core/incidence_csr.hpp"
 #include "core/ordered_sweep.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/sort_short.hpp"
+#include "dim3/escobar_objective.hpp"
 #include "dim3/moving_tet.hpp"
 
 namespace febemesh::dim3 {
@@ -133,6 +133,23 @@ bool has_avx() { return __builtin_cpu_supports("avx"); }
 bool has_avx() { return false; }
 #endif
 FEBEMESH_TARGET_AVX P3 lanes_gradient_avx(const MovingTet& m, const P3& x, double h) { return lanes_gradient<4>(m, x, h); }
+/// The sum of escobar_objective over the first n lanes of `blocks`, added in lane order (as
+/// one tetrahedron at a time: the same number).
+template <int N>
+[[gnu::always_inline]] inline double escobar_sum_lanes(const EscobarLanes<N>* blocks, std::int32_t n, const P3& x,
+                                                       double scale, double delta) {
+  double k = 0.0;
+  for (std::int32_t b = 0; N * b < n; ++b) {
+    double e[N];
+    blocks[b].objective(x, scale, delta, e);
+    for (std::int32_t l = 0; l < N && N * b + l < n; ++l) k += e[l];
+  }
+  return k;
+}
+FEBEMESH_TARGET_AVX double escobar_sum_avx(const EscobarLanes<4>* blocks, std::int32_t n, const P3& x, double scale,
+                                           double delta) {
+  return escobar_sum_lanes<4>(blocks, n, x, scale, delta);
+}
 FEBEMESH_TARGET_AVX double lanes_worst_above_avx(const std::vector<MovingTet>& local, const MovingTetLanes<4>* blocks,
                                                  double* trial, const P3& x, double bound, std::int32_t& first) {
   return lanes_worst_above<4>(local, blocks, trial, x, bound, first);
@@ -201,6 +218,9 @@ struct Optimizer {
     /// The same in blocks of lanes (the last one padded with copies): fours with AVX, else pairs.
     std::vector<MovingTetLanes<4>> quads;
     std::vector<MovingTetLanes<2>> pairs;
+    /// escobar_descent's node's tetrahedra for the Escobar objective, in fours or pairs.
+    std::vector<EscobarLanes<4>> escobar_quads;
+    std::vector<EscobarLanes<2>> escobar_pairs;
     std::vector<double> trial, best_ranks;  ///< their ranks at a candidate, at the best one
     std::vector<std::int32_t> woken;  ///< the nodes this thread woke for the next sweep
     std::size_t moves = 0;
@@ -240,33 +260,28 @@ struct Optimizer {
     for (std::size_t k = 0; k < blocks.size(); ++k)
       for (std::size_t l = 0; l < N; ++l) blocks[k].set_lane(static_cast<int>(l), local[std::min(N * k + l, local.size() - 1)]);
   }
-  /// Escobar et al.'s untangling objective of tetrahedron t with v at x: |S|^2 / (3 h(s)^(2/3)),
-  /// S its Jacobian against the regular tetrahedron of edge `scale`, s = det S and
-  /// h(s) = (s + sqrt(s^2 + 4 delta^2)) / 2 > 0, so that the sum over a node's tetrahedra is
-  /// finite and smooth across inverted ones, and its minimum lies where they are positive.
-  double escobar_at(std::int32_t t, std::int32_t v, const P3& x, double scale, double delta) const {
-    std::array<P3, 4> p;
-    for (int k = 0; k < 4; ++k) p[k] = tets[t][k] == v ? x : mesh.points[tets[t][k]];
-    // Inverse of the regular tetrahedron's edge matrix (columns (1,0,0), (1/2, sqrt3/2, 0),
-    // (1/2, sqrt3/6, sqrt(2/3))).
-    static const Eigen::Matrix3d w_inv = [] {
-      Eigen::Matrix3d w;
-      w << 1.0, 0.5, 0.5, 0.0, std::sqrt(3.0) / 2.0, std::sqrt(3.0) / 6.0, 0.0, 0.0, std::sqrt(2.0 / 3.0);
-      return Eigen::Matrix3d(w.inverse());
-    }();
-    Eigen::Matrix3d a;
-    a.col(0) = (p[1] - p[0]) / scale;
-    a.col(1) = (p[2] - p[0]) / scale;
-    a.col(2) = (p[3] - p[0]) / scale;
-    const Eigen::Matrix3d sm = a * w_inv;
-    const double sigma = sm.determinant();
-    const double hs = 0.5 * (sigma + std::sqrt(sigma * sigma + 4.0 * delta * delta));
-    return sm.squaredNorm() / (3.0 * std::cbrt(hs * hs));
+  /// v's tetrahedra in lanes of the Escobar objective (their other nodes stay put while v
+  /// descends), the last block padded with copies of the last tetrahedron.
+  template <int N> void fill_escobar(std::int32_t v, std::vector<EscobarLanes<N>>& blocks) const {
+    const std::int32_t n = start[v + 1] - start[v];
+    blocks.resize(static_cast<std::size_t>((n + N - 1) / N));
+    for (std::int32_t i = 0; i < N * static_cast<std::int32_t>(blocks.size()); ++i) {
+      const Tet& t = tets[incident[start[v] + std::min(i, n - 1)]];
+      std::array<P3, 4> p;
+      int slot = 0;
+      for (int k = 0; k < 4; ++k) {
+        p[k] = mesh.points[t[k]];
+        if (t[k] == v) slot = k;
+      }
+      blocks[static_cast<std::size_t>(i / N)].set_lane(i % N, p, slot);
+    }
   }
-  double escobar_sum(std::int32_t v, const P3& x, double scale, double delta) const {
-    double k = 0.0;
-    for (std::int32_t i = start[v]; i < start[v + 1]; ++i) k += escobar_at(incident[i], v, x, scale, delta);
-    return k;
+  /// The sum of escobar_objective over v's tetrahedra with v at x, in incidence order (sc:
+  /// fill_escobar's blocks of v).
+  double escobar_sum(std::int32_t v, const P3& x, double scale, double delta, const Scratch& sc) const {
+    const std::int32_t n = start[v + 1] - start[v];
+    return avx ? escobar_sum_avx(sc.escobar_quads.data(), n, x, scale, delta)
+               : escobar_sum_lanes<2>(sc.escobar_pairs.data(), n, x, scale, delta);
   }
   int n_inverted_at(std::int32_t v, const P3& x) const {
     int n = 0;
@@ -284,7 +299,7 @@ struct Optimizer {
   /// surface nodes). Max-min steps stall where no single direction raises the worst
   /// tetrahedron; the smooth sum still has a descent direction there. The result is taken when
   /// it inverts no more tetrahedra (and folds no more interface triangles) and lowers the sum.
-  bool escobar_descent(std::int32_t v, const P3& x0, double len, P3& x_out, BoundaryLocation& w_out) const {
+  bool escobar_descent(std::int32_t v, const P3& x0, double len, P3& x_out, BoundaryLocation& w_out, Scratch& sc) const {
     const double scale = len;
     double sigma_min = std::numeric_limits<double>::infinity();
     for (std::int32_t i = start[v]; i < start[v + 1]; ++i) {
@@ -301,7 +316,11 @@ struct Optimizer {
     const int fold0 = guard ? n_folded_at(v, x0, node_normal(v)) : 0;
     P3 x = x0;
     BoundaryLocation w = surf ? where[v] : BoundaryLocation{};
-    double k = escobar_sum(v, x, scale, delta);
+    if (avx)
+      fill_escobar(v, sc.escobar_quads);
+    else
+      fill_escobar(v, sc.escobar_pairs);
+    double k = escobar_sum(v, x, scale, delta, sc);
     const double k0 = k;
     const double hd = 1e-5 * len;
     for (int it = 0; it < 8; ++it) {
@@ -310,7 +329,7 @@ struct Optimizer {
         P3 xp = x, xm = x;
         xp[d] += hd;
         xm[d] -= hd;
-        g[d] = (escobar_sum(v, xp, scale, delta) - escobar_sum(v, xm, scale, delta)) / (2 * hd);
+        g[d] = (escobar_sum(v, xp, scale, delta, sc) - escobar_sum(v, xm, scale, delta, sc)) / (2 * hd);
       }
       if (surf) {
         const P3 n = node_normal(v);
@@ -323,7 +342,7 @@ struct Optimizer {
         P3 y = x + step * dir;
         BoundaryLocation wy;
         if (surf) std::tie(y, wy) = opt.project(y);
-        const double ky = escobar_sum(v, y, scale, delta);
+        const double ky = escobar_sum(v, y, scale, delta, sc);
         if (ky < k) {
           x = y, w = wy, k = ky, stepped = true;
           break;
@@ -558,7 +577,7 @@ struct Optimizer {
       P3 ex;
       BoundaryLocation ew;
       const P3 from = best_x;
-      if (escobar_descent(v, from, len, ex, ew) && !(ex == x0) && within(v, ex)) {
+      if (escobar_descent(v, from, len, ex, ew, sc) && !(ex == x0) && within(v, ex)) {
         best_x = ex, best_w = ew;
         for (std::size_t k = 0; k < local.size(); ++k) best_ranks[k] = local[k].rank(ex);
       }
