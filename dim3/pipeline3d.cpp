@@ -1289,7 +1289,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
             // with the faults behind those tetrahedra.
             std::vector<Problem3> sites;
             for (const auto& site : v.sites)
-              if (site.node >= 0 && std::string_view(site.kind) != "an interface node is off the boundary")
+              if (site.node >= 0 && std::string_view(site.kind) != off_boundary_kind)
                 sites.push_back({fe.mesh.points[static_cast<std::size_t>(site.node)], site.kind});
             if (!sites.empty()) {
               for (const Problem3& p : sites) at_fault.push_back(p.where);
