@@ -6,9 +6,9 @@
 #include <set>
 #include <span>
 
+#include "core/cube_faces.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/quality.hpp"
-#include "dim3/triangle_predicates.hpp"
 
 namespace febemesh::dim3 {
 namespace {
