@@ -722,7 +722,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       r.max_boundary_distance = std::max(r.max_boundary_distance, d);
       if (!(d <= options.boundary_tolerance)) {
         ++r.off_boundary_nodes;
-        problems.add("an interface node is off the boundary", v, [&](auto& os) {
+        problems.add(off_boundary_kind, v, [&](auto& os) {
           os << "interface node " << v << " at " << fmt<Dim>(pts[v]) << " is " << d << " from the boundary";
         });
       }

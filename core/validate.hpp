@@ -36,6 +36,10 @@ template <int Dim> struct ValidateOptions {
   int n_threads = 1;
 };
 
+/// ValidationReport::ProblemSite::kind of an interface node farther from the boundary than
+/// ValidateOptions::boundary_tolerance (a pipeline that refines around the other sites skips it).
+inline constexpr char off_boundary_kind[] = "an interface node is off the boundary";
+
 struct ValidationReport {
   bool valid = false;
   std::size_t n_points = 0, n_solid = 0, n_interface = 0;

@@ -1,0 +1,27 @@
+#pragma once
+// One try of the 3D pipeline at fixed options (internal to dim3: pipeline3d.cpp's tries call it):
+// the first tree, then the repair loop, which classifies the octants, builds the boundary
+// octants and the tetrahedra, untangles them and runs the quality stage, and where that leaves
+// problems drops or refines octants around them and builds again.
+
+#include <cstddef>
+
+#include "dim3/pipeline3d.hpp"
+#include "dim3/surface_boundary.hpp"
+
+namespace febemesh::dim3 {
+
+/// The work of one run in octants built on, and its bound (Options3d::effort): 0 until the
+/// first tree is known.
+struct Effort {
+  std::size_t used = 0;
+  std::size_t limit = 0;
+};
+
+/// One try of the pipeline with `opt` (no fallback): `s` gets the options' levels, `effort`
+/// counts the octants built on (and gets its limit from the first tree when it has none). Throws
+/// GeometryError when the repairs cannot make the mesh valid (unless a valid coarser mesh of
+/// the try stands) and LimitError past the work bound or max_cells.
+Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress);
+
+}  // namespace febemesh::dim3
