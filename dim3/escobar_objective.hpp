@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <Eigen/LU>

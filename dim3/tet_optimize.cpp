@@ -9,7 +9,6 @@
 #include <mutex>
 #include <span>
 
-
 #include "core/error.hpp"
 #include "core/incidence_csr.hpp"
 #include "core/ordered_sweep.hpp"
