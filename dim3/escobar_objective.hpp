@@ -20,7 +20,8 @@
 
 #include <Eigen/LU>
 
-#include "dim3/moving_tet.hpp"  // Lanes<N>
+#include "core/box.hpp"  // Point
+#include "dim3/lanes.hpp"
 
 namespace febemesh::dim3 {
 
@@ -58,10 +59,9 @@ inline double escobar_objective(const std::array<Point<3>, 4>& p, double scale, 
 
 /// N tetrahedra sharing one moving node, stored coordinate by coordinate: corner k of lane l
 /// is the moving node where moving[k] has lane l set, else fixed[k][.][l].
-template <int N> struct EscobarLanes {
-  static_assert(N == 2 || N == 4);
-  using V = typename Lanes<N>::V;
-  using M = typename Lanes<N>::M;
+template <int N> struct EscobarLanes : private LaneOps<N> {
+  using typename LaneOps<N>::V;
+  using typename LaneOps<N>::M;
 
   alignas(8 * N) double fixed[4][3][N];
   alignas(8 * N) std::int64_t moving[4][N];
@@ -108,24 +108,10 @@ template <int N> struct EscobarLanes {
   }
 
  private:
-  [[gnu::always_inline]] static V load(const double* a) {
-    V v;
-    __builtin_memcpy(&v, a, sizeof v);
-    return v;
-  }
-  [[gnu::always_inline]] static M load_mask(const std::int64_t* a) {
-    M m;
-    __builtin_memcpy(&m, a, sizeof m);
-    return m;
-  }
-  [[gnu::always_inline]] static V splat(double a) {
-    V v;
-    for (int l = 0; l < N; ++l) v[l] = a;
-    return v;
-  }
-  [[gnu::always_inline]] static V select(const M& m, const V& a, const V& b) {
-    return reinterpret_cast<V>((m & reinterpret_cast<M>(a)) | (~m & reinterpret_cast<M>(b)));
-  }
+  using LaneOps<N>::load;
+  using LaneOps<N>::load_mask;
+  using LaneOps<N>::splat;
+  using LaneOps<N>::select;
 };
 
 #if defined(__GNUC__)

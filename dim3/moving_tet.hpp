@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/box.hpp"  // Point
+#include "dim3/lanes.hpp"
 
 namespace febemesh::dim3 {
 
@@ -75,27 +76,14 @@ struct MovingTet {
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
-/// N-double vectors and their lane masks (all bits or none). Spelled out per N: GCC ignores
-/// vector_size with a size that depends on a template parameter.
-template <int N> struct Lanes;
-template <> struct Lanes<2> {
-  using V = double __attribute__((vector_size(16)));
-  using M = std::int64_t __attribute__((vector_size(16)));
-};
-template <> struct Lanes<4> {
-  using V = double __attribute__((vector_size(32)));
-  using M = std::int64_t __attribute__((vector_size(32)));
-};
-
 /// N lanes of MovingTet (N tetrahedra, or one tetrahedron N times), stored field by field.
 /// rank() works on N-double vectors: with N = 2 one SSE2 instruction per operation; with N = 4
 /// one AVX instruction when called from a function compiled for AVX (tet_optimize.cpp picks it
 /// at run time), else two SSE2 ones.
-template <int N> struct MovingTetLanes {
-  static_assert(N == 2 || N == 4);
+template <int N> struct MovingTetLanes : private LaneOps<N> {
   static constexpr int n_lanes = N;
-  using V = typename Lanes<N>::V;
-  using M = typename Lanes<N>::M;
+  using typename LaneOps<N>::V;
+  using typename LaneOps<N>::M;
 
   alignas(8 * N) double q1[3][N], q2[3][N], q3[3][N], n0[3][N], inv0[N], l2_fixed[N];
 
@@ -170,16 +158,9 @@ template <int N> struct MovingTetLanes {
                   select(not_positive, r_inverted,
                          select(zero_face, zero, splat(std::numeric_limits<double>::quiet_NaN()))));
   }
-  [[gnu::always_inline]] static V load(const double* a) {
-    V v;
-    __builtin_memcpy(&v, a, sizeof v);
-    return v;
-  }
-  [[gnu::always_inline]] static V splat(double a) {
-    V v;
-    for (int l = 0; l < N; ++l) v[l] = a;
-    return v;
-  }
+  using LaneOps<N>::load;
+  using LaneOps<N>::splat;
+  using LaneOps<N>::select;
   [[gnu::always_inline]] static V dot(const V (&a)[3], const V (&b)[3]) {
     return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
   }
@@ -187,9 +168,6 @@ template <int N> struct MovingTetLanes {
     c[0] = a[1] * b[2] - a[2] * b[1];
     c[1] = a[2] * b[0] - a[0] * b[2];
     c[2] = a[0] * b[1] - a[1] * b[0];
-  }
-  [[gnu::always_inline]] static V select(const M& m, const V& a, const V& b) {
-    return reinterpret_cast<V>((m & reinterpret_cast<M>(a)) | (~m & reinterpret_cast<M>(b)));
   }
   /// std::max(a, b) = a < b ? b : a (ties and NaN keep a): one maxpd.
   [[gnu::always_inline]] static V max(const V& a, const V& b) { return a < b ? b : a; }

@@ -8,9 +8,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 
 #include "dim3/escobar_objective.hpp"
+#include "lane_testing.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -18,21 +18,8 @@ using namespace febemesh::dim3;
 namespace {
 
 using P3 = Point<3>;
-
-std::uint64_t bits(double x) {
-  std::uint64_t b;
-  std::memcpy(&b, &x, sizeof b);
-  return b;
-}
-
-struct Rng {
-  std::uint64_t s;
-  double uniform() {
-    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return double(s >> 11) / double(1ULL << 53) - 0.5;
-  }
-  P3 point(double scale) { return scale * P3(uniform(), uniform(), uniform()); }
-};
+using test::bits;
+using test::Rng;
 
 struct Tally {
   long lanes = 0, mismatched = 0, inverted = 0;

@@ -8,10 +8,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <vector>
 
 #include "dim3/moving_tet.hpp"
+#include "lane_testing.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -19,21 +19,8 @@ using namespace febemesh::dim3;
 namespace {
 
 using P3 = Point<3>;
-
-std::uint64_t bits(double x) {
-  std::uint64_t b;
-  std::memcpy(&b, &x, sizeof b);
-  return b;
-}
-
-struct Rng {
-  std::uint64_t s;
-  double uniform() {
-    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
-    return double(s >> 11) / double(1ULL << 53) - 0.5;
-  }
-  P3 point(double scale) { return scale * P3(uniform(), uniform(), uniform()); }
-};
+using test::bits;
+using test::Rng;
 
 struct Tally {
   int common = 0;      ///< lanes ranked above 0
