@@ -68,7 +68,7 @@ struct Options3d {
   /// the buffer rule, without it, with facing projections) before any without it, instead of
   /// each try once more without snapping at once (Result3d::features_dropped then means all the
   /// tries with it were refused). An experiment (branch tries-order): off, the meshes stay the same.
-  bool features_fallback_last = true;
+  bool features_fallback_last = false;
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
   /// BoundaryOctantOptions::graze_region and graze_length, for the untangling's moves too. Off:
   /// no try sets them (measured on rotor's sampled thickness try, docs/measurements.md, branch
