@@ -47,6 +47,7 @@ Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, Effort& effor
     r.features_dropped = true;
     return r;
   }
+  if (opt.features_fallback_last) return once(opt);  // mesh3d_tries falls back, after every try
   return with_fallback(once, opt, plain, "without feature snapping", &Result3d::features_dropped, progress);
 }
 
@@ -91,6 +92,20 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
 }
 
+/// mesh3d_facing; with Options3d::features_fallback_last on a surface whose feature lines are
+/// snapped to (not faceted), every try with feature snapping first, and only when all of them
+/// are refused every try without it, in the same order.
+Result3d mesh3d_tries(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
+  const auto facing = [&](const Options3d& o) { return mesh3d_facing(s, o, effort, progress); };
+  const bool snaps = opt.snap_features && s.features().n_feature_edges() > 0 &&
+                     !(s.features().free_end_share() > opt.faceted_free_ends);
+  if (!opt.features_fallback_last || !snaps) return facing(opt);
+  Options3d plain = opt;
+  plain.snap_features = false;
+  return with_fallback(facing, opt, plain, "without feature snapping, every try", &Result3d::features_dropped,
+                       progress);
+}
+
 }  // namespace
 
 std::size_t apply_buffer_rules(const Orthtree<3>& t, Flags& in, const SurfaceBoundary& s, const Options3d& opt) {
@@ -121,14 +136,14 @@ double volume_error(const Mesh<3>& m, const SurfaceBoundary& s, int n_threads) {
   return std::abs(solid_measure<3>(m, n_threads) - s.volume()) / std::abs(s.volume());
 }
 
-/// mesh3d_facing, and when every try is refused although they built on fewer octants than
+/// mesh3d_tries, and when every try is refused although they built on fewer octants than
 /// opt.min_effort_octants (a coarse level: the features are a couple of octants across), once
 /// more one level finer within that many octants (Result3d::level_raised). Measured: the 4x4x4
 /// voxel union of tests/dim3/regressions (seed 5, case 180) is refused at level 3 through every
 /// try and valid at levels 4 and 5. A costly refusal (spool L6: millions of octants) stands.
 Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   try {
-    return mesh3d_facing(s, opt, effort, progress);
+    return mesh3d_tries(s, opt, effort, progress);
   } catch (const GeometryError& e) {
     if (opt.raise_levels <= 0 || effort.used >= opt.min_effort_octants) throw;
     if (progress) progress("refused at level " + std::to_string(opt.level) + " (" + e.what() + "): once more at level " +
@@ -160,14 +175,14 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 
 namespace {
 
-/// One try after every other was refused: mesh3d_facing with `o` within its own work bound of
+/// One try after every other was refused: mesh3d_tries with `o` within its own work bound of
 /// o.effort first trees. The mesh (its n_octants_built counting `effort` too), or the refusal's
 /// reason in `why`.
 std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o, const Effort& effort,
                                           std::string& why, const Progress3& progress) {
   Effort own;
   try {
-    Result3d t = mesh3d_facing(s, o, own, progress);
+    Result3d t = mesh3d_tries(s, o, own, progress);
     t.n_octants_built = effort.used + own.used;
     return t;
   } catch (const GeometryError& f) {
@@ -271,7 +286,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
              " octants across the thin parts, without the buffer rule");
   Effort thin_effort;
   try {
-    Result3d t = mesh3d_facing(s, thin, thin_effort, progress);
+    Result3d t = mesh3d_tries(s, thin, thin_effort, progress);
     t.n_octants_built = r.n_octants_built + thin_effort.used;
     const ValidationReport v = validate(t.fe.mesh, surface_validation(s, opt.n_threads));
     const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);

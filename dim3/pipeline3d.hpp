@@ -64,6 +64,11 @@ struct Options3d {
   /// leave through every free face of their node and land on surface facing it (min_outward and
   /// min_facing 0.3, outward_all_faces) and accept_valid_folds (Result3d::facing_projection).
   bool retry_facing = true;
+  /// On a surface that is not faceted (faceted_free_ends), every try with feature snapping (with
+  /// the buffer rule, without it, with facing projections) before any without it, instead of
+  /// each try once more without snapping at once (Result3d::features_dropped then means all the
+  /// tries with it were refused). An experiment (branch tries-order): off, the meshes stay the same.
+  bool features_fallback_last = false;
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
   /// BoundaryOctantOptions::graze_region and graze_length, for the untangling's moves too. Off:
   /// no try sets them (measured on rotor's sampled thickness try, docs/measurements.md, branch
@@ -230,7 +235,9 @@ using Progress3 = std::function<void(const std::string&)>;
 /// with feature snapping it runs once more without (Result3d::features_dropped); when both fail
 /// with the buffer rule, the two once more without it (Result3d::buffer_dropped); when all
 /// fail, those without the buffer once more with facing projections (Options3d::retry_facing);
-/// when those are refused cheaply, all of it one level finer (Options3d::raise_levels).
+/// when those are refused cheaply, all of it one level finer (Options3d::raise_levels). With
+/// Options3d::features_fallback_last the tries without feature snapping come after all those
+/// with it.
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 /// The buffer rules of opt on the interior octants `in`: Options3d::buffer, then flat_buffer

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/local_repair.hpp"
@@ -200,6 +201,74 @@ TEST_CASE("mesh3d leaves out the thin parts after every refining try is refused"
   CHECK(run(true, with).empty());
   CHECK(with.thin_parts_coarse);
   CHECK_FALSE(with.thickness_after_refusal);
+}
+
+namespace {
+
+/// The fallbacks mesh3d announced, in order: each progress message "X, after: why" gives X.
+struct Fallbacks {
+  std::vector<std::string> seen;
+  Progress3 progress() {
+    return [this](const std::string& m) {
+      const auto at = m.find(", after: ");
+      if (at != std::string::npos) seen.push_back(m.substr(0, at));
+    };
+  }
+};
+
+}  // namespace
+
+// Options3d::features_fallback_last on the 12x8 torus of the regressions (every edge a feature,
+// no free ends, so snapped to): with feature snapping and the buffer rule it is refused. Off, the
+// next try drops the snapping; on, it drops the buffer rule and keeps the snapping, and meshes.
+TEST_CASE("mesh3d with features_fallback_last tries feature snapping without the buffer next", "[pipeline3d]") {
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-12x8-feature-snap-inverted.off";
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  opt.thin_retry_cells = 0;  // the flags of the first mesh, not of the thickness retry's
+  for (const bool last : {false, true}) {
+    SurfaceBoundary s = SurfaceBoundary::from_file(file);
+    REQUIRE_FALSE(s.features().free_end_share() > opt.faceted_free_ends);
+    opt.features_fallback_last = last;
+    Fallbacks f;
+    const Result3d r = mesh3d(s, opt, f.progress());
+    INFO("features_fallback_last " << last);
+    REQUIRE_FALSE(f.seen.empty());
+    CHECK(f.seen[0] == (last ? "without the buffer rule" : "without feature snapping"));
+    CHECK(r.features_dropped == !last);
+    CHECK(r.buffer_dropped == last);
+    CHECK_FALSE(r.facing_projection);
+    CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+  }
+}
+
+// On the voxel union of the regressions with a hanging node at a concave edge (its cube edges
+// are features, with no free ends) at level 3 with one repair a try, every try that snaps is
+// refused, and the one without snapping and with the buffer rule too: features_fallback_last
+// runs them in mesh3d's order, the three with snapping first, and the mesh is the one without
+// snapping and without the buffer rule; the flags say so.
+TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every try with it", "[pipeline3d]") {
+  if (test::sanitized()) return;  // 3 CPU s in Release (five tries of up to two trees)
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-hanging-node-concave-edge.off";
+  SurfaceBoundary s = SurfaceBoundary::from_file(file);
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  opt.max_repairs = 1;
+  opt.raise_levels = 0;
+  opt.thin_retry_cells = 0;
+  opt.features_fallback_last = true;
+  REQUIRE_FALSE(s.features().free_end_share() > opt.faceted_free_ends);
+  Fallbacks f;
+  const Result3d r = mesh3d(s, opt, f.progress());
+  const std::vector<std::string> order = {"without the buffer rule", "with facing projections only",
+                                          "without feature snapping, every try", "without the buffer rule"};
+  CHECK(f.seen == order);
+  CHECK(r.features_dropped);
+  CHECK(r.buffer_dropped);
+  CHECK_FALSE(r.facing_projection);
+  CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
 }
 
 // Options3d::faceted_free_ends: the same sphere's 30-degree creases are facets, most of them
