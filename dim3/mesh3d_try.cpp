@@ -394,14 +394,12 @@ struct RepairLoop {
       tm.fe = tetrahedralize(tree, tm.oc.complex, surface_point, opt.n_threads, &interior_tets, &tm.fe);
       const std::vector<Box<3>> bounds =
           opt.untangle_reach > 0 ? move_bounds(tree, tm.oc.complex, tm.fe, opt.untangle_reach) : std::vector<Box<3>>{};
-      {
-        // Untangle by moving nodes (interior ones freely, surface ones on the surface,
-        // corners not at all) before giving up snaps or refining.
-        const TetOptimizeStats ts =
-            untangle_pass(tm.fe, tm.oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads, bounds);
-        r.n_untangle_moves += ts.moves;
-        say(untangle_summary("untangling", ts));
-      }
+      // Untangle by moving nodes (interior ones freely, surface ones on the surface,
+      // corners not at all) before giving up snaps or refining.
+      const TetOptimizeStats ts =
+          untangle_pass(tm.fe, tm.oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads, bounds);
+      r.n_untangle_moves += ts.moves;
+      say(untangle_summary("untangling", ts));
       const std::vector<std::size_t> bad = inverted_elements(tm.fe.mesh, opt.n_threads);
       const std::vector<std::size_t> folded = folded_faces(tm.fe.mesh, tm.fe.where, s, opt.n_threads);
       std::set<std::int32_t> revert;
@@ -416,11 +414,28 @@ struct RepairLoop {
       for (std::size_t f : folded) revert_snapped(tm.fe.mesh.interface, f);
       if (bad.empty() && folded.empty()) break;
       if (revert.empty()) {
+        const int last_round = opt.untangle_rounds + 4;  // the round that no longer moves surface nodes
+        std::vector<UntangleUndo> undo;
         const std::size_t moved =
-            round < opt.untangle_rounds + 4
-                ? untangle(tree, tm.in, s, opt.graze, opt.graze_region, opt.graze_length, bad, tm.oc.complex, tm.fe)
+            round < last_round
+                ? untangle(tree, tm.in, s, opt.graze, opt.graze_region, opt.graze_length, bad, tm.oc.complex, tm.fe, &undo)
                 : 0;
         r.n_untangled += moved;
+        if (moved > 0 && opt.skip_repeated_rounds && complex_unchanged(undo, tm.oc.complex)) {
+          // Every node went back to the complex point it had: the next round's tetrahedra and
+          // untangling are this round's, bit for bit, and so are its moves, up to the last
+          // round. Skip to that round's end (its mesh is this one before the moves; the counts
+          // as if the rounds had run). Measured: the same mesh.msh and report counts.
+          for (auto u = undo.rbegin(); u != undo.rend(); ++u)
+            tm.fe.mesh.points[static_cast<std::size_t>(u->node)] = u->mesh_point;
+          const std::size_t repeats = static_cast<std::size_t>(last_round - round - 1);
+          r.n_untangled += repeats * moved;
+          r.n_untangle_moves += (repeats + 1) * ts.moves;
+          say("untangling: the " + std::to_string(repeats + 1) +
+              " round(s) after this one would repeat it (every moved node back where it was): skipped");
+          untangle_last_resort(tm, bad, folded, bounds);
+          break;
+        }
         if (moved == 0) {
           untangle_last_resort(tm, bad, folded, bounds);
           break;

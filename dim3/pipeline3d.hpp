@@ -76,6 +76,11 @@ struct Options3d {
   /// cases valid. A mesh changes only where a try with snapping now stands before one without
   /// it would have.
   bool features_fallback_last = true;
+  /// Where a round of the untangling's surface node moves leaves the complex as it was (every
+  /// node moved back to its own point), the rounds after it, up to the last, would repeat it bit
+  /// for bit: they are skipped, with the same mesh and counts (untangle3d's complex_unchanged).
+  /// Off only to check that (tests/dim3/test_pipeline3d.cpp).
+  bool skip_repeated_rounds = true;
   double graze = 0.05;               ///< projection segments may graze interior octants by this x size
   /// BoundaryOctantOptions::graze_region and graze_length, for the untangling's moves too. Off:
   /// no try sets them (measured on rotor's sampled thickness try, docs/measurements.md, branch

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <span>
 
@@ -68,7 +69,8 @@ std::vector<std::size_t> inverted_elements(const Mesh<3>& m, int n_threads) {
 }
 
 std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, bool graze_region,
-                     double graze_length, const std::vector<std::size_t>& bad, OctantComplex& oc, TetMesh& fe) {
+                     double graze_length, const std::vector<std::size_t>& bad, OctantComplex& oc, TetMesh& fe,
+                     std::vector<UntangleUndo>* undo) {
   const std::int32_t n_lat = oc.n_lattice(), n_pts = static_cast<std::int32_t>(oc.points.size());
   Mesh<3>& m = fe.mesh;
   if (bad.empty()) return 0;
@@ -141,12 +143,32 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
       if (n < best && admissible(p, cands[c].point)) best = n, pick = c;
     }
     if (pick < 0) continue;
+    if (undo) undo->push_back({p, m.points[p], oc.points[p], oc.where[p]});
     oc.points[p] = cands[pick].point;
     oc.where[p] = cands[pick].where;
     m.points[p] = cands[pick].point;
     ++moved;
   }
   return moved;
+}
+
+namespace {
+
+template <typename T> bool same_bits(const T& a, const T& b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
+
+bool same_location(const BoundaryLocation& a, const BoundaryLocation& b) {
+  return a.patch == b.patch && same_bits(a.param[0], b.param[0]) && same_bits(a.param[1], b.param[1]) &&
+         a.kind == b.kind && a.feature == b.feature;
+}
+
+}  // namespace
+
+bool complex_unchanged(const std::vector<UntangleUndo>& undo, const OctantComplex& oc) {
+  return std::all_of(undo.begin(), undo.end(), [&](const UntangleUndo& u) {
+    const P3& x = oc.points[static_cast<std::size_t>(u.node)];
+    return same_bits(x.x(), u.complex_point.x()) && same_bits(x.y(), u.complex_point.y()) &&
+           same_bits(x.z(), u.complex_point.z()) && same_location(oc.where[static_cast<std::size_t>(u.node)], u.complex_where);
+  });
 }
 
 std::vector<std::size_t> folded_faces(const Mesh<3>& m, const std::vector<BoundaryLocation>& where,

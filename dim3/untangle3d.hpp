@@ -27,14 +27,28 @@ namespace febemesh::dim3 {
 /// on one thread, twice a run).
 std::vector<std::size_t> inverted_elements(const Mesh<3>& m, int n_threads = 1);
 
+/// A node untangle moved: where it was in the mesh and in the complex before.
+struct UntangleUndo {
+  std::int32_t node = -1;
+  P3 mesh_point, complex_point;
+  BoundaryLocation complex_where;
+};
+
 /// Surface nodes of inverted tets move to another surface point when that leaves fewer of their
 /// tets inverted: the projection of the mean of their surface neighbours (a smoothed
 /// projection, which unfolds crossed projections), halfway there, or the first surface point
 /// along the mean outward normal of their free faces. Every candidate must stay admissible from
 /// all the face nodes projecting onto it. `bad`: the mesh's inverted elements
-/// (inverted_elements). Returns how many nodes moved.
+/// (inverted_elements). Returns how many nodes moved. With `undo`, each moved node's state
+/// before the move is appended to it (UntangleUndo).
 std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundary& s, double graze, bool graze_region,
-                     double graze_length, const std::vector<std::size_t>& bad, OctantComplex& oc, TetMesh& fe);
+                     double graze_length, const std::vector<std::size_t>& bad, OctantComplex& oc, TetMesh& fe,
+                     std::vector<UntangleUndo>* undo = nullptr);
+
+/// True when untangle's moves left the complex as it was, bit for bit: every moved node went to
+/// the complex point (and surface location) it already had, the mesh's untangled position only
+/// having changed. The next round's tetrahedra are then this round's again.
+bool complex_unchanged(const std::vector<UntangleUndo>& undo, const OctantComplex& oc);
 
 /// Interface triangles folded over on the surface: their normal points against the surface's
 /// (the sum of the normals of the surface triangles their nodes lie on). Positive tetrahedra do

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -272,6 +273,55 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
   CHECK(r.buffer_dropped);
   CHECK_FALSE(r.facing_projection);
   CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+}
+
+// Options3d::skip_repeated_rounds on the voxel union of the island trial at level 4: in its first
+// try a round of the untangling's surface node moves puts every node back on its own point, and
+// the rounds after it are skipped. Off, they run: each prints the skipped round's summary again,
+// and every line after it, the refused try's reasons, the mesh (bit for bit) and its counts are
+// the same.
+TEST_CASE("mesh3d skips the untangling rounds that would repeat one, with the same mesh", "[pipeline3d]") {
+  if (test::sanitized()) return;  // 2 x 2.3 CPU s in Release
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-island-trial.off";
+  Options3d opt;
+  opt.level = 4;
+  opt.n_threads = 1;
+  std::vector<std::string> lines[2];
+  Result3d r[2];
+  for (const bool skip : {true, false}) {
+    SurfaceBoundary s = SurfaceBoundary::from_file(file);
+    opt.skip_repeated_rounds = skip;
+    r[skip ? 0 : 1] = mesh3d(s, opt, [&](const std::string& m) { lines[skip ? 0 : 1].push_back(m); });
+  }
+  // The lines with the skip, each "the N round(s) after this one would repeat it" line replaced
+  // by N copies of the untangling line before it: the lines without.
+  std::vector<std::string> expanded;
+  std::size_t n_skips = 0;
+  const std::string mark = "untangling: the ";
+  for (const std::string& m : lines[0]) {
+    if (m.rfind(mark, 0) == 0 && m.find("would repeat it") != std::string::npos) {
+      ++n_skips;
+      REQUIRE_FALSE(expanded.empty());
+      const std::string repeated = expanded.back();
+      CHECK(repeated.rfind("untangling: inverted tetrahedra", 0) == 0);
+      const int n = std::stoi(m.substr(mark.size()));
+      CHECK(n >= 1);
+      for (int k = 0; k < n; ++k) expanded.push_back(repeated);
+      continue;
+    }
+    expanded.push_back(m);
+  }
+  CHECK(n_skips >= 1);
+  CHECK(expanded == lines[1]);
+  const Mesh<3>&a = r[0].fe.mesh, &b = r[1].fe.mesh;
+  REQUIRE(a.points.size() == b.points.size());
+  CHECK(std::memcmp(a.points.data(), b.points.data(), a.points.size() * sizeof(a.points[0])) == 0);
+  CHECK(a.solid.node == b.solid.node);
+  CHECK(a.interface.node == b.interface.node);
+  CHECK(r[0].n_untangled == r[1].n_untangled);
+  CHECK(r[0].n_untangle_moves == r[1].n_untangle_moves);
+  CHECK(r[0].n_repairs == r[1].n_repairs);
+  CHECK(r[0].buffer_dropped == r[1].buffer_dropped);
 }
 
 // Options3d::faceted_free_ends: the same sphere's 30-degree creases are facets, most of them
