@@ -4,7 +4,7 @@
 // tetrahedra with one moving node at once, lane by lane with the same IEEE operations in the
 // same order, so its values equal escobar_objective's bit for bit and the untangled mesh does
 // not change. The objective was a fifth of fandisk L5's one-thread run (perf: its arithmetic
-// 10.6%, the cube root 9.9%); the cube root stays one libm call a lane.
+// 10.6%, the cube root 9.9%); the cube root is glibc's algorithm in lanes (cube_root.hpp).
 //
 // The order Eigen 3.4 gives (found by comparing bits over 2 x 10^6 random tetrahedra, and
 // checked by tests/dim3/test_escobar_objective.cpp): the product S = A W^-1 sums each
@@ -21,6 +21,7 @@
 #include <Eigen/LU>
 
 #include "core/box.hpp"  // Point
+#include "dim3/cube_root.hpp"
 #include "dim3/lanes.hpp"
 
 namespace febemesh::dim3 {
@@ -49,7 +50,7 @@ inline double escobar_objective(const std::array<Point<3>, 4>& p, double scale, 
   const Eigen::Matrix3d sm = a * w_inv;
   const double sigma = sm.determinant();
   const double hs = 0.5 * (sigma + std::sqrt(sigma * sigma + 4.0 * delta * delta));
-  return sm.squaredNorm() / (3.0 * std::cbrt(hs * hs));
+  return sm.squaredNorm() / (3.0 * cube_root(hs * hs));
 }
 
 #if defined(__GNUC__)
@@ -101,8 +102,7 @@ template <int N> struct EscobarLanes : private LaneOps<N> {
     for (int l = 0; l < N; ++l) root[l] = std::sqrt(under[l]);
     const V hs = 0.5 * (sigma + root);
     const V hs2 = hs * hs;
-    V cube = splat(0.0);
-    for (int l = 0; l < N; ++l) cube[l] = std::cbrt(hs2[l]);
+    const V cube = cube_root_lanes<N>(hs2);
     const V r = norm2 / (3.0 * cube);
     __builtin_memcpy(out, &r, sizeof r);
   }
