@@ -154,11 +154,11 @@ std::size_t untangle(const Orthtree<3>& t, const Flags& in, const SurfaceBoundar
 
 namespace {
 
+/// The same bits (a point's three doubles, a location's two parameters; -0.0 is not 0.0 here).
 template <typename T> bool same_bits(const T& a, const T& b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
 
 bool same_location(const BoundaryLocation& a, const BoundaryLocation& b) {
-  return a.patch == b.patch && same_bits(a.param[0], b.param[0]) && same_bits(a.param[1], b.param[1]) &&
-         a.kind == b.kind && a.feature == b.feature;
+  return a.patch == b.patch && same_bits(a.param, b.param) && a.kind == b.kind && a.feature == b.feature;
 }
 
 }  // namespace
@@ -166,8 +166,7 @@ bool same_location(const BoundaryLocation& a, const BoundaryLocation& b) {
 bool complex_unchanged(const std::vector<UntangleUndo>& undo, const OctantComplex& oc) {
   return std::all_of(undo.begin(), undo.end(), [&](const UntangleUndo& u) {
     const P3& x = oc.points[static_cast<std::size_t>(u.node)];
-    return same_bits(x.x(), u.complex_point.x()) && same_bits(x.y(), u.complex_point.y()) &&
-           same_bits(x.z(), u.complex_point.z()) && same_location(oc.where[static_cast<std::size_t>(u.node)], u.complex_where);
+    return same_bits(x, u.complex_point) && same_location(oc.where[static_cast<std::size_t>(u.node)], u.complex_where);
   });
 }
 

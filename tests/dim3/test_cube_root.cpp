@@ -24,28 +24,20 @@ namespace {
 #pragma GCC diagnostic ignored "-Wpsabi"
 #endif
 
-void roots2(const double* in, double* out) {
-  Lanes<2>::V v;
+template <int N> [[gnu::always_inline]] inline void roots(const double* in, double* out) {
+  typename Lanes<N>::V v;
   std::memcpy(&v, in, sizeof v);
-  const Lanes<2>::V r = cube_root_lanes<2>(v);
+  const typename Lanes<N>::V r = cube_root_lanes<N>(v);
   std::memcpy(out, &r, sizeof r);
 }
 
+void roots2(const double* in, double* out) { roots<2>(in, out); }
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-[[gnu::target("avx")]] void roots4(const double* in, double* out) {
-  Lanes<4>::V v;
-  std::memcpy(&v, in, sizeof v);
-  const Lanes<4>::V r = cube_root_lanes<4>(v);
-  std::memcpy(out, &r, sizeof r);
-}
+[[gnu::target("avx")]] void roots4(const double* in, double* out) { roots<4>(in, out); }
 bool has_avx() { return __builtin_cpu_supports("avx"); }
 #else
-void roots4(const double* in, double* out) {
-  Lanes<4>::V v;
-  std::memcpy(&v, in, sizeof v);
-  const Lanes<4>::V r = cube_root_lanes<4>(v);
-  std::memcpy(out, &r, sizeof r);
-}
+void roots4(const double* in, double* out) { roots<4>(in, out); }
 bool has_avx() { return false; }
 #endif
 
