@@ -43,8 +43,9 @@ const char* help_text =
     "  --elements KIND     tet (default), or hex: hex-dominant (hexahedra where the octants\n"
     "                      conform, pyramids and tetrahedra elsewhere; quad BE faces where\n"
     "                      a hexahedron's or pyramid's surface face stays a quad)\n"
-    "  --buffer X          drop interior octants nearer the surface than X times their size\n"
-    "                      (0..0.5, default 0.2)\n"
+    "  --buffer X          the buffer rule of the last try (after the tries without it):\n"
+    "                      drop interior octants nearer the surface than X times their\n"
+    "                      size (0..0.5, default 0.2; 0: no such try)\n"
     "  --smooth N          smoothing iterations (0..50, default 4)\n"
     "  --no-features       do not snap to feature edges and corners (also skipped on a\n"
     "                      faceted surface, where most feature lines end in smooth surface)\n"
@@ -94,7 +95,8 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--allow-invalid", "--binary"},
+  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first", "--allow-invalid",
+                   "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
@@ -109,6 +111,9 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for comparisons with the order before session 29: each try once more without
   // feature snapping at once (Options3d::features_fallback_last off).
   opt.features_fallback_last = !args.has("--features-fallback-first");
+  // Hidden, for comparisons with the order before session 31: the buffer rule's try first
+  // (Options3d::buffer_last off).
+  opt.buffer_last = !args.has("--buffer-first");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
@@ -174,9 +179,11 @@ int run(const std::vector<std::string>& argv) {
                     {"smoothing_iterations", opt.smoothing_iterations},
                     {"snap_features", opt.snap_features},
                     {"features_fallback_last", opt.features_fallback_last},
+                    {"buffer_last", opt.buffer_last},
                     {"threads", opt.n_threads},
                     {"msh_encoding", encoding == MshEncoding::Binary ? "binary" : "ascii"},
                     {"buffer_rule_dropped", r.buffer_dropped},
+                    {"buffer_rule_fallback", r.buffer_fallback},
                     {"feature_snapping_dropped", r.features_dropped},
                     {"facing_projection", r.facing_projection},
                     {"thickness_refined", r.thickness_refined},

@@ -89,7 +89,21 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   // after the other tries, so that the meshes they make stay bit for bit the same (anchor L5 is
   // refused with these projection rules and the buffer).
   const Options3d facing = facing_try_options(opt);
-  return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
+  if (!opt.buffer_last || !(opt.buffer > 0) || !opt.retry_without_buffer)
+    return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
+  // Options3d::buffer_last: without the buffer rule, then with facing projections, and with the
+  // buffer rule only when both are refused.
+  const auto features = [&](const Options3d& o) { return mesh3d_features(s, o, effort, progress); };
+  Options3d plain = opt;
+  plain.buffer = 0.0;
+  try {
+    return with_fallback(features, plain, facing, "with facing projections only", &Result3d::facing_projection, progress);
+  } catch (const GeometryError& e) {
+    if (progress) progress(std::string("with the buffer rule, after: ") + e.what());
+    Result3d r = features(opt);
+    r.buffer_fallback = true;
+    return r;
+  }
 }
 
 /// mesh3d_facing; with Options3d::features_fallback_last on a surface whose feature lines are

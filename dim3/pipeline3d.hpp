@@ -52,6 +52,14 @@ struct Options3d {
   double faceted_free_ends = 0.5;
   /// When the run with the buffer rule fails, run once more without it (Result3d::buffer_dropped).
   bool retry_without_buffer = true;
+  /// The try without the buffer rule first, then the one with facing projections, and the one
+  /// with the buffer rule only when both are refused (Result3d::buffer_fallback), instead of the
+  /// buffer rule's try first (then without it, then facing). In the L4/L5 runs of the shared
+  /// surfaces the buffer rule's try stood only on sphere966 and anchor L5, where the try without
+  /// it makes a mesh as good; elsewhere it was refused, at up to a third of the run (fandisk L5
+  /// 5.6 of 28 s, spool L5 6.8 of 9.2 s, elephant L4 9.5 of 27.5 s). Measured:
+  /// docs/measurements.md, session 31. Off: the order before (mesh3d --buffer-first).
+  bool buffer_last = true;
   bool peel = false;                 ///< drop the octants at blind face nodes instead of refining
   /// When the untangling leaves inverted tets or folded interface triangles, drop the interior
   /// octants at the lattice nodes behind them (thicker boundary octants) up to this many times
@@ -218,6 +226,7 @@ struct Result3d {
   int n_repairs = 0;
   std::size_t n_octants_built = 0;   ///< octants of every tree built on, over all tries (Options3d::effort)
   bool buffer_dropped = false;       ///< the run with the buffer rule failed; this one is without
+  bool buffer_fallback = false;      ///< Options3d::buffer_last: the runs without the buffer rule failed; this one has it
   bool features_dropped = false;     ///< the run with feature snapping failed; this one is without
   bool facing_projection = false;    ///< the runs above failed; this one has Options3d::retry_facing's rules
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
@@ -243,13 +252,13 @@ struct Result3d {
 using Progress3 = std::function<void(const std::string&)>;
 
 /// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
-/// LimitError when the tree would exceed max_cells. `s` gets the options' levels. When it fails
-/// with feature snapping it runs once more without (Result3d::features_dropped); when both fail
-/// with the buffer rule, the two once more without it (Result3d::buffer_dropped); when all
-/// fail, those without the buffer once more with facing projections (Options3d::retry_facing);
-/// when those are refused cheaply, all of it one level finer (Options3d::raise_levels). With
-/// Options3d::features_fallback_last the tries without feature snapping come after all those
-/// with it.
+/// LimitError when the tree would exceed max_cells. `s` gets the options' levels. The tries, in
+/// order (Options3d::buffer_last): without the buffer rule; with facing projections
+/// (Options3d::retry_facing, Result3d::facing_projection); with the buffer rule
+/// (Result3d::buffer_fallback). Without buffer_last: with the buffer rule; without it
+/// (Result3d::buffer_dropped); with facing projections. All of them with feature snapping first,
+/// then all without (Options3d::features_fallback_last, Result3d::features_dropped); when those
+/// are refused cheaply, all of it one level finer (Options3d::raise_levels).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 /// The buffer rules of opt on the interior octants `in`: Options3d::buffer, then flat_buffer

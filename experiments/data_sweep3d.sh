@@ -7,6 +7,7 @@
 # tests/cli checks that).
 # Usage: experiments/data_sweep3d.sh [BUILD_DIR] [OUT_DIR]
 #   LEVELS="4 5 6" KINDS="tet hex" SURFACES="sphere966 anchor" THREADS=1 narrow it down;
+#   ARGS="--buffer 0" passes more options to every run;
 #   KEEP=0 removes each run's folder once its row is printed (level 6 meshes are 0.1-1 GB);
 #   the exit status is 1 when any run is not valid (the regression tests dim3_data_levels_SURFACE,
 #   tests/CMakeLists.txt, one per surface, run it at levels 4-6 in both kinds).
@@ -19,6 +20,7 @@ levels=${LEVELS:-"4 5 6"}
 kinds=${KINDS:-"tet"}
 threads=${THREADS:-1}
 keep=${KEEP:-1}
+read -r -a args <<< "${ARGS:-}"
 surfaces=${SURFACES:-$(cd "$data/3d" && ls *.off | grep -v '^open-' | sed 's/\.off$//' | tr '\n' ' ')}
 [ -x /usr/bin/time ] || { echo "data_sweep3d: needs GNU time (/usr/bin/time)" >&2; exit 1; }
 mkdir -p "$out"
@@ -31,7 +33,7 @@ for s in $surfaces; do
       d="$out/$s-L$level-$kind"
       rm -rf "$d"
       /usr/bin/time -f "%U %S %M" -o "$d.time" "$bin" mesh3d "$data/3d/$s.off" -o "$d" --level "$level" \
-        --elements "$kind" --threads "$threads" --allow-invalid >/dev/null 2>"$d.err"
+        --elements "$kind" --threads "$threads" --allow-invalid "${args[@]}" >/dev/null 2>"$d.err"
       read -r user sys peak_kb < <(tail -n 1 "$d.time")
       python3 - "$d/report.json" "$s" "$level" "$kind" "$user" "$sys" "$peak_kb" "$d.err" <<'PY' > "$d.row"
 import json, os, sys
@@ -45,7 +47,7 @@ if not os.path.exists(path):
     sys.exit(0)
 r = json.load(open(path))
 c, q, f, v = r["counts"], r["quality"], r["fidelity"], r["validation"]
-notes = [k for k in ("buffer_rule_dropped", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal")
+notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal")
          if r["options"].get(k)]
 status = "valid" if v["valid"] else "invalid"
 print(f"| {s} | {level} | {kind} | {status} | {q['n_elements']} | {c['tetrahedra']} | {q['min_dihedral_deg']:.2f} | "

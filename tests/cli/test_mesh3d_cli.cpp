@@ -91,3 +91,27 @@ TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary", "[cli][mesh3
   CHECK(nlohmann::json::parse(read_text(dir / "ascii" / "report.json"))["options"]["msh_encoding"] == "ascii");
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores the buffer rule's try first", "[cli][mesh3d]") {
+  // sphere966 at level 4: every try stands at once, so the first try of each order makes the
+  // mesh: without the buffer rule by default (no octant dropped by it), with it under
+  // --buffer-first (octants dropped). Both valid; the report says which order ran.
+  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_order_" + std::to_string(::getpid()));
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  const std::string common = "mesh3d '" + sphere + "' --level 4 --quiet --threads 1 -o '";
+  REQUIRE(run_status(common + (dir / "last").string() + "'") == 0);
+  REQUIRE(run_status(common + (dir / "first").string() + "' --buffer-first") == 0);
+  const auto last = nlohmann::json::parse(read_text(dir / "last" / "report.json"));
+  const auto first = nlohmann::json::parse(read_text(dir / "first" / "report.json"));
+  CHECK(last["options"]["buffer_last"] == true);
+  CHECK(first["options"]["buffer_last"] == false);
+  CHECK(last["counts"]["buffer_dropped"] == 0);
+  CHECK(first["counts"]["buffer_dropped"] > 0);
+  for (const auto* r : {&last, &first}) {
+    CHECK((*r)["validation"]["valid"] == true);
+    CHECK((*r)["options"]["buffer_rule_fallback"] == false);
+    CHECK((*r)["options"]["buffer_rule_dropped"] == false);
+  }
+  CHECK(read_text(dir / "last" / "mesh.msh") != read_text(dir / "first" / "mesh.msh"));
+  std::filesystem::remove_all(dir);
+}

@@ -83,9 +83,11 @@ TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeli
   opt.n_threads = 1;
   opt.min_effort_octants = 0;
   opt.faceted_free_ends = 1.0;  // snap although its creases are facets (see the next test)
-  // The order of tries this bound was measured on: each once more without snapping at once
-  // (with the tries without snapping last, the run keeps snapping and drops the buffer rule).
+  // The order of tries this bound was measured on: the buffer rule's try first, each try once
+  // more without snapping at once (with the tries without snapping last, the run keeps snapping
+  // and drops the buffer rule).
   opt.features_fallback_last = false;
+  opt.buffer_last = false;
   if (!test::sanitized()) {  // the whole run: 5 CPU s in Release, too long under ASan
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
     const Result3d r = mesh3d(s, opt);
@@ -225,12 +227,15 @@ struct Fallbacks {
 // Options3d::features_fallback_last on the 12x8 torus of the regressions (every edge a feature,
 // no free ends, so snapped to): with feature snapping and the buffer rule it is refused. Off, the
 // next try drops the snapping; on, it drops the buffer rule and keeps the snapping, and meshes.
+// (The order with the buffer rule's try first, Options3d::buffer_last off; on, the try without
+// the buffer rule and with snapping is the first and stands, below.)
 TEST_CASE("mesh3d with features_fallback_last tries feature snapping without the buffer next", "[pipeline3d]") {
   const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-12x8-feature-snap-inverted.off";
   Options3d opt;
   opt.level = 3;
   opt.n_threads = 1;
   opt.thin_retry_cells = 0;  // the flags of the first mesh, not of the thickness retry's
+  opt.buffer_last = false;
   for (const bool last : {false, true}) {
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
     REQUIRE_FALSE(s.features().free_end_share() > opt.faceted_free_ends);
@@ -263,6 +268,7 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
   opt.raise_levels = 0;
   opt.thin_retry_cells = 0;
   opt.features_fallback_last = true;
+  opt.buffer_last = false;  // the buffer rule's try first (the order this case was found in)
   REQUIRE_FALSE(s.features().free_end_share() > opt.faceted_free_ends);
   Fallbacks f;
   const Result3d r = mesh3d(s, opt, f.progress());
@@ -271,6 +277,48 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
   CHECK(f.seen == order);
   CHECK(r.features_dropped);
   CHECK(r.buffer_dropped);
+  CHECK_FALSE(r.facing_projection);
+  CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+}
+
+// Options3d::buffer_last (the default): the try without the buffer rule first, then the one
+// with facing projections, then the buffer rule's. The 12x8 torus above meshes at the first
+// try, with snapping and without the buffer rule (where the buffer rule's try was refused
+// first); on the voxel union with the hanging node all three tries with snapping are refused in
+// that order, and the mesh is the first try without snapping, without the buffer rule.
+TEST_CASE("mesh3d tries without the buffer rule first, with facing projections next, the buffer rule last", "[pipeline3d]") {
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  opt.thin_retry_cells = 0;
+  REQUIRE(opt.buffer_last);
+  REQUIRE(opt.buffer > 0);
+  {
+    SurfaceBoundary s =
+        SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-12x8-feature-snap-inverted.off");
+    Fallbacks f;
+    const Result3d r = mesh3d(s, opt, f.progress());
+    CHECK(f.seen.empty());
+    CHECK_FALSE(r.features_dropped);
+    CHECK_FALSE(r.buffer_dropped);
+    CHECK_FALSE(r.buffer_fallback);
+    CHECK_FALSE(r.facing_projection);
+    CHECK(r.n_buffer_dropped == 0);  // no buffer rule in the try that stood
+    CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+  }
+  if (test::sanitized()) return;  // 2 CPU s in Release (four tries)
+  SurfaceBoundary s =
+      SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-hanging-node-concave-edge.off");
+  opt.max_repairs = 1;
+  opt.raise_levels = 0;
+  Fallbacks f;
+  const Result3d r = mesh3d(s, opt, f.progress());
+  const std::vector<std::string> order = {"with facing projections only", "with the buffer rule",
+                                          "without feature snapping, every try"};
+  CHECK(f.seen == order);
+  CHECK(r.features_dropped);
+  CHECK_FALSE(r.buffer_dropped);
+  CHECK_FALSE(r.buffer_fallback);
   CHECK_FALSE(r.facing_projection);
   CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
 }
@@ -286,6 +334,7 @@ TEST_CASE("mesh3d skips the untangling rounds that would repeat one, with the sa
   Options3d opt;
   opt.level = 4;
   opt.n_threads = 1;
+  opt.buffer_last = false;  // the skip happens in the buffer rule's try
   std::vector<std::string> lines[2];
   Result3d r[2];
   for (const bool skip : {true, false}) {
