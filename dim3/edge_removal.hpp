@@ -70,6 +70,9 @@ struct EdgeRemovalOptions {
   double contract_min_gain_deg = 0.0;
   /// Per node: 1 = never contracted away (the pipeline: the feature corners). Empty: none.
   std::vector<std::uint8_t> keep;
+  /// Per node: when not empty, only the tetrahedra with a node marked 1 are tried (and the
+  /// tetrahedra the removals make). Empty: every tetrahedron under below_deg.
+  std::vector<std::uint8_t> only_at;
   /// Threads for the scan of every tetrahedron's quality (the removals themselves run in order
   /// on one); the result is the same for every count.
   int n_threads = 1;

@@ -167,6 +167,51 @@ TEST_CASE("edge removal mends the anchor L5 surface edge that no node move can",
   }
 }
 
+// EdgeRemovalOptions::only_at (the hex-dominant mesh's second rounds): only tetrahedra with a
+// marked node are tried. On the anchor ridge, no node marked: nothing removed, the mesh as it
+// was; the worst tetrahedron's nodes marked: it goes, and the tetrahedra with no marked node
+// that no removal touched stay as they were.
+TEST_CASE("edge removal with only_at tries the tetrahedra at the marked nodes only", "[edge_removal]") {
+  std::vector<BoundaryLocation> where;
+  const Mesh<3> start = anchor_ridge(where);
+  std::size_t worst = 0;
+  double lo = 180.0;
+  for (std::size_t e = 0; e < start.solid.size(); ++e) {
+    const VertexId* v = start.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const double a = tet_min_dihedral_deg(start.points[v[0].v], start.points[v[1].v], start.points[v[2].v], start.points[v[3].v]);
+    if (a < lo) lo = a, worst = e;
+  }
+  REQUIRE(lo < 10.0);
+  EdgeRemovalOptions eo;
+  eo.surface_normal = anchor_normal;
+  {
+    Mesh<3> m = start;
+    std::vector<std::int32_t> cell = own_cells(m);
+    eo.only_at.assign(m.points.size(), 0);
+    const EdgeRemovalStats st = remove_bad_edges(m, where, &cell, eo);
+    CHECK(st.removed == 0);
+    CHECK(m.solid.node == start.solid.node);
+  }
+  Mesh<3> m = start;
+  std::vector<std::int32_t> cell = own_cells(m);
+  eo.only_at.assign(m.points.size(), 0);
+  const VertexId* w = start.solid.nodes(ElemId{static_cast<std::int32_t>(worst)});
+  for (int k = 0; k < 4; ++k) eo.only_at[static_cast<std::size_t>(w[k].v)] = 1;
+  const EdgeRemovalStats st = remove_bad_edges(m, where, &cell, eo);
+  CHECK(st.removed >= 1);
+  CHECK(std::binary_search(st.cells_changed.begin(), st.cells_changed.end(), static_cast<std::int32_t>(worst)));
+  CHECK(faces_match(m));
+  for (std::size_t e = 0; e < m.solid.size(); ++e) CHECK(volume6(m, e) > 0);
+  // The tetrahedra of unchanged cells are the input's, node for node.
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const std::int32_t c = cell[e];
+    if (std::binary_search(st.cells_changed.begin(), st.cells_changed.end(), c)) continue;
+    const VertexId* a = m.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const VertexId* b = start.solid.nodes(ElemId{c});
+    for (int k = 0; k < 4; ++k) CHECK(a[k].v == b[k].v);
+  }
+}
+
 TEST_CASE("edge removal inside a jittered cube keeps the volume and raises the worst angle", "[edge_removal][property]") {
   test::prop("jittered Kuhn cubes", 20, [](unsigned seed) {
     Mesh<3> m = jittered_kuhn_grid(seed, 0.6);
