@@ -86,8 +86,9 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   // surface facing it, without the buffer rule; interface triangles the fold test still flags
   // (their nodes on sheets whose normals disagree) are kept when the validator accepts the mesh.
   // Measured (fandisk L4, diagnose3d): valid after 3 repairs, 131238 tets, 11.8 deg, 1.6%. Only
-  // after the other tries, so that the meshes they make stay bit for bit the same (anchor L5 is
-  // refused with these projection rules and the buffer).
+  // after the try without the buffer rule (and, without Options3d::buffer_last, the buffer
+  // rule's), so that the meshes they make stay the same (anchor L5 is refused with these
+  // projection rules and the buffer).
   const Options3d facing = facing_try_options(opt);
   if (!opt.buffer_last || !(opt.buffer > 0) || !opt.retry_without_buffer)
     return with_fallback(buffer, opt, facing, "with facing projections only", &Result3d::facing_projection, progress);
