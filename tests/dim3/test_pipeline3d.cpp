@@ -323,6 +323,31 @@ TEST_CASE("mesh3d tries without the buffer rule first, with facing projections n
   CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
 }
 
+// The buffer rule's try, last, standing where the two before it are refused: voxel union seed 4,
+// case 81 of the survey, at level 3 (found in session 31 by counting the tries of 200 cases of
+// voxel seeds 4 and 5: it stood once and was refused six times). Without the thickness retry,
+// which replaces this mesh by default (it loses 10.7% of the volume; the CLI's mesh is the
+// retry's, the same as in the order before), so that the try's own mesh and flags are seen.
+TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused", "[pipeline3d]") {
+  if (test::sanitized()) return;  // about 3 CPU s in Release (three tries)
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) +
+                                                 "/tests/dim3/regressions/voxel-seed4-case81-buffer-fallback.off");
+  Options3d opt;
+  opt.level = 3;
+  opt.n_threads = 1;
+  opt.thin_retry_cells = 0;
+  Fallbacks f;
+  const Result3d r = mesh3d(s, opt, f.progress());
+  const std::vector<std::string> order = {"with facing projections only", "with the buffer rule"};
+  CHECK(f.seen == order);
+  CHECK(r.buffer_fallback);
+  CHECK_FALSE(r.buffer_dropped);
+  CHECK_FALSE(r.facing_projection);
+  CHECK_FALSE(r.features_dropped);
+  CHECK(r.n_buffer_dropped > 0);
+  CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+}
+
 // Options3d::skip_repeated_rounds on the voxel union of the island trial at level 4: in its first
 // try a round of the untangling's surface node moves puts every node back on its own point, and
 // the rounds after it are skipped. Off, they run: each prints the skipped round's summary again,
