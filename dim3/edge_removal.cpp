@@ -479,11 +479,6 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   for_each_chunk(static_cast<std::size_t>(w.n_input), chunk, opt.n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       const Tet n = w.tet(static_cast<std::int32_t>(t));
-      if (!opt.only_at.empty() && !(opt.only_at[static_cast<std::size_t>(n[0])] | opt.only_at[static_cast<std::size_t>(n[1])] |
-                                    opt.only_at[static_cast<std::size_t>(n[2])] | opt.only_at[static_cast<std::size_t>(n[3])])) {
-        if (ranks && !ranked) (*ranks)[t] = tet_search_rank(mesh.points[n[0]], mesh.points[n[1]], mesh.points[n[2]], mesh.points[n[3]]);
-        continue;
-      }
       double r = 0.0;
       if (ranked) {
         r = (*ranks)[t];
@@ -492,6 +487,9 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
         if (ranks) (*ranks)[t] = r;
       }
       if (!(r < below_rank)) continue;
+      if (!opt.only_at.empty() && !(opt.only_at[static_cast<std::size_t>(n[0])] | opt.only_at[static_cast<std::size_t>(n[1])] |
+                                    opt.only_at[static_cast<std::size_t>(n[2])] | opt.only_at[static_cast<std::size_t>(n[3])]))
+        continue;
       if (const double q = w.quality(n); q < below) bad_in[c].push_back({q, static_cast<std::int32_t>(t)});
     }
   });

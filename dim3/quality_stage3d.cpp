@@ -4,6 +4,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <numbers>
 
 #include "core/smooth.hpp"
 #include "dim3/edge_removal.hpp"
@@ -207,9 +208,14 @@ void improve_quality(const SurfaceBoundary& s, OctantComplex& complex, TetMesh& 
         // other cells keep their hexes and pyramids. Measured (elephant L5 hex, CLI, one thread):
         // 14.06 deg left under the 15 deg bar (14.32 with a 20 deg bar everywhere), where the
         // tetrahedral mesh's 30 deg rounds reach 19.72 deg.
+        // The passes' ranks (tet_search_rank at the current points) pick the candidates, with
+        // edge removal's margin; their angles decide.
+        const bool ranked = ranks.size() == fe.mesh.solid.size();
+        const double below_rank = tet_search_rank_of_angle(opt.hex.min_dihedral_deg * std::numbers::pi / 180.0) + 1e-9;
         std::vector<std::uint8_t> near(fe.mesh.points.size(), 0);
         bool any = false;
         for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+          if (ranked && !(ranks[e] < below_rank)) continue;
           const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
           const auto& p = fe.mesh.points;
           if (!(tet_min_dihedral_deg(p[v[0].v], p[v[1].v], p[v[2].v], p[v[3].v]) < opt.hex.min_dihedral_deg)) continue;
