@@ -95,7 +95,8 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first", "--allow-invalid",
+  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
+                   "--no-thickness-probe", "--allow-invalid",
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort"});
   args.expect_positional({"SURFACE"});
@@ -114,6 +115,9 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for comparisons with the order before session 31: the buffer rule's try first
   // (Options3d::buffer_last off).
   opt.buffer_last = !args.has("--buffer-first");
+  // Hidden, for comparisons with the tries before session 32: no thickness try's first tree
+  // after a first tree with problems (Options3d::thickness_probe off).
+  opt.thickness_probe = !args.has("--no-thickness-probe");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
@@ -180,6 +184,7 @@ int run(const std::vector<std::string>& argv) {
                     {"snap_features", opt.snap_features},
                     {"features_fallback_last", opt.features_fallback_last},
                     {"buffer_last", opt.buffer_last},
+                    {"thickness_probe", opt.thickness_probe},
                     {"threads", opt.n_threads},
                     {"msh_encoding", encoding == MshEncoding::Binary ? "binary" : "ascii"},
                     {"buffer_rule_dropped", r.buffer_dropped},
@@ -189,6 +194,7 @@ int run(const std::vector<std::string>& argv) {
                     {"thickness_refined", r.thickness_refined},
                     {"thickness_after_refusal", r.thickness_after_refusal},
                     {"thin_parts_coarse", r.thin_parts_coarse},
+                    {"thickness_early", r.thickness_early},
                     {"level_raised", r.level_raised}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},

@@ -141,6 +141,7 @@ struct RepairLoop {
   bool island_trial_reverted = false;  // the trial did not resolve the thin parts
   int trial_attempts = 0;  // attempts spent on a reverted trial
   std::optional<Classified> classified;
+  bool first_of_run = false;  // this loop's first tree is its run's first (Effort::first_tree_built)
 
   RepairLoop(SurfaceBoundary& surface, const Options3d& options, Effort& work, const Progress3& say_to)
       : s(surface), opt(options), effort(work), progress(say_to) {}
@@ -174,6 +175,7 @@ struct RepairLoop {
     balancing.n_threads = opt.n_threads;  // the same tree for every count
     tree = balance_2to1(tree, BalanceKind::Full, balancing);
     clock.lap("balance");
+    first_of_run = !std::exchange(effort.first_tree_built, true);
     if (effort.limit == 0)
       effort.limit = std::max(static_cast<std::size_t>(opt.effort * static_cast<double>(tree.n_leaves())),
                               opt.min_effort_octants);
@@ -400,6 +402,10 @@ struct RepairLoop {
           untangle_pass(tm.fe, tm.oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads, bounds);
       r.n_untangle_moves += ts.moves;
       say(untangle_summary("untangling", ts));
+      if (round == 0 && opt.first_round_inverted_share > 0 &&
+          static_cast<double>(ts.inverted_after) > opt.first_round_inverted_share * static_cast<double>(ts.inverted_before))
+        throw GeometryError("the first round of untangling left " + std::to_string(ts.inverted_after) + " of " +
+                            std::to_string(ts.inverted_before) + " tetrahedra inverted");
       const std::vector<std::size_t> bad = inverted_elements(tm.fe.mesh, opt.n_threads);
       const std::vector<std::size_t> folded = folded_faces(tm.fe.mesh, tm.fe.where, s, opt.n_threads);
       std::set<std::int32_t> revert;
@@ -699,6 +705,51 @@ struct RepairLoop {
     return true;
   }
 
+  /// Options3d::thickness_probe, once, after the run's first tree left problems: the thickness
+  /// try's first tree, with no repair; its mesh when it has no problem and validates. The
+  /// surface gets this try's levels back either way.
+  std::optional<Result3d> thickness_probe() {
+    if (!std::exchange(first_of_run, false) || !opt.thickness_probe || opt.thickness_cells > 0 ||
+        !thickness_try_applies(s, opt))
+      return std::nullopt;
+    Options3d thick = thickness_try_options(opt);
+    thick.max_repairs = 0;
+    thick.first_round_inverted_share = 0.02;
+    say("the first tree has problems and the solid has thin parts: the first tree with " +
+        std::to_string(thick.thickness_cells) + " octants across them, without the buffer rule and without a repair");
+    std::optional<Result3d> stands;
+    Effort own;
+    try {
+      RepairLoop probe(s, thick, own, progress);
+      Result3d t = probe.run();
+      ValidationReport v = t.validation && t.validation_hash == content_hash(t.fe.mesh)
+                               ? *t.validation
+                               : validate(t.fe.mesh, surface_validation(s, opt.n_threads));
+      if (v.valid) {
+        t.validation = std::move(v);
+        t.validation_hash = content_hash(t.fe.mesh);
+        t.thickness_early = true;
+        std::vector<StageTime3> times = r.times;
+        times.insert(times.end(), t.times.begin(), t.times.end());
+        t.times = std::move(times);
+        stands = std::move(t);
+        say("thin parts: the first tree with the thickness level stands");
+      } else {
+        say("thin parts: the first tree with the thickness level is not valid (" + v.summary() + "); going on");
+      }
+    } catch (const GeometryError& e) {
+      say(std::string("thin parts: the first tree with the thickness level has problems (") + e.what() + "); going on");
+    } catch (const LimitError& e) {
+      say(std::string("thin parts: the first tree with the thickness level is over its bounds (") + e.what() +
+          "); going on");
+    }
+    effort.used += own.used;
+    s.set_global_level(opt.level);
+    s.set_max_level(opt.level + opt.extra_levels);
+    s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+    return stands;
+  }
+
   /// The loop: a tree after another until one's mesh has no problem (or the try stops).
   Result3d run() {
     first_tree();
@@ -719,6 +770,7 @@ struct RepairLoop {
         if (refine_surface_octants(tm, true, euler)) continue;
       }
       if (tm.problems.empty()) return finish(tm);
+      if (std::optional<Result3d> thick = thickness_probe()) return std::move(*thick);
       if (peel_around_problems(tm)) continue;
       if (!refine_around_problems(tm)) return restore_saved();
     }

@@ -16,6 +16,7 @@ namespace febemesh::dim3 {
 struct Effort {
   std::size_t used = 0;
   std::size_t limit = 0;
+  bool first_tree_built = false;  ///< the run's first tree (Options3d::thickness_probe looks at it only)
 };
 
 /// One try of the pipeline with `opt` (no fallback): `s` gets the options' levels, `effort`

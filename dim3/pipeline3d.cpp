@@ -144,6 +144,23 @@ Options3d facing_try_options(const Options3d& opt) {
   return facing;
 }
 
+Options3d thickness_try_options(const Options3d& opt) {
+  Options3d thick = opt;
+  thick.raise_levels = 0;
+  thick.effort = std::min(opt.effort, opt.thin_retry_effort);
+  thick.min_effort_octants = 0;
+  thick.thickness_cells = opt.refused_thickness_cells;
+  thick.buffer = 0.0;  // its one-octant slabs in thin parts project through them (thin retry)
+  return thick;
+}
+
+bool thickness_try_applies(SurfaceBoundary& s, const Options3d& opt) {
+  const double cells = opt.refused_thickness_cells;
+  if (!(cells > 0)) return false;
+  const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
+  return s.thin_share(cells * h_feature) > 0;
+}
+
 namespace {
 
 /// |volume of the solid elements - the surface's| / the surface's.
@@ -164,6 +181,7 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
     if (progress) progress("refused at level " + std::to_string(opt.level) + " (" + e.what() + "): once more at level " +
                            std::to_string(opt.level + 1));
     Options3d finer = opt;
+    finer.thickness_probe = false;  // the tries at the finer level as they were
     ++finer.level;
     --finer.raise_levels;
     finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);  // refused early, not after a huge tree
@@ -218,20 +236,15 @@ template <class E>
 Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& effort, const E& e,
                        const Progress3& progress) {
   const double cells = opt.refused_thickness_cells;
-  if (!(cells > 0) || opt.thickness_cells > 0) throw e;
-  // Only where the thickness level passes the feature level (level + 1), else the first tree is
-  // the one refused already.
-  const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
-  if (!(s.thin_share(cells * h_feature) > 0)) throw e;
+  if (opt.thickness_cells > 0 || !thickness_try_applies(s, opt)) throw e;
   std::string reasons = e.what(), why;
   // Both tries: no level raise, their own work bound of thin_retry_effort first trees.
+  const Options3d thick = thickness_try_options(opt);
   Options3d after = opt;
   after.raise_levels = 0;
-  after.effort = std::min(opt.effort, opt.thin_retry_effort);
+  after.effort = thick.effort;
   after.min_effort_octants = 0;
-  Options3d thick = after;
-  thick.thickness_cells = cells;
-  thick.buffer = 0.0;  // its one-octant slabs in thin parts project through them (thin retry)
+  after.thickness_probe = false;
   if (progress)
     progress(std::string("refused (") + e.what() + "): once more with " + std::to_string(cells) +
              " octants across the thin parts, without the buffer rule");
@@ -272,7 +285,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   r.n_octants_built = effort.used;
   Options3d ran = opt;  // the thickness retry below is at the level the mesh was made at
   ran.level += r.level_raised;
-  if (!(ran.thin_retry_cells > 0) || ran.thickness_cells > 0) return r;
+  if (!(ran.thin_retry_cells > 0) || ran.thickness_cells > 0 || r.thickness_early) return r;
   const double error = volume_error(r.fe.mesh, s, opt.n_threads);
   if (!(error > ran.thin_retry_error)) return r;
   // Parts thinner than the octants (rotor's blades, spool's flanges at level 4) have no

@@ -180,6 +180,22 @@ struct Options3d {
   /// with 4 octants across, up to level 8, the first try is valid without a repair (diagnose3d
   /// --single --buffer 0: 3,186,715 tets, 11.05 deg, 0.16% volume error, 32 s CPU, 737 MB).
   double refused_thickness_cells = 4.0;
+  /// Where that try would run (thin parts, as for refused_thickness_cells) and the run's first
+  /// tree leaves problems after its untangling, the first tree of that try is built at once,
+  /// without a repair (its options, thickness_try_options): when its mesh has no problem and
+  /// passes the validator, it stands (Result3d::thickness_early), else the run goes on from its
+  /// own first tree as without this. Measured (spool L6, CLI, one thread): every try was
+  /// refused after 339 s, then that try stood at its first tree (374 s wall in all); now the
+  /// same mesh.msh in 35 s wall (28 s CPU). The thickness level's first trees of anchor L4,
+  /// elephant L4-L6 and fandisk L4-L6 have problems, so their meshes stay the same, at the
+  /// probe's cost (0.0-0.6 s CPU with first_round_inverted_share's early end).
+  bool thickness_probe = true;
+  /// The probe's early end: a try whose first round of untangling leaves more than this share
+  /// of its tetrahedra inverted at the templates is refused there (GeometryError); 0 = off (every
+  /// try but the probe). Measured (first rounds at the thickness level): spool L6 16106 -> 19
+  /// (0.1%, it stands); anchor L4 34%, fandisk L4 6%, fandisk L5 8%, elephant L4 5% (all refused
+  /// after their nine rounds and the Escobar pass).
+  double first_round_inverted_share = 0.0;
   /// When that try is refused too (or not run), once more without what refines the thin parts
   /// to 1-3 octants across: no feature level (SurfaceOptions::feature_extra_levels 0: on a
   /// coarse tessellation the triangles touching a feature edge cover whole thin sheets), no
@@ -232,6 +248,7 @@ struct Result3d {
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
   bool thickness_after_refusal = false;  ///< refused; this run has Options3d::refused_thickness_cells' thickness level
   bool thin_parts_coarse = false;    ///< refused; this run has Options3d::coarse_thin_after_refusal's rules
+  bool thickness_early = false;      ///< the first tree had problems; this run is Options3d::thickness_probe's tree
   int level_raised = 0;              ///< refused at Options3d::level; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
@@ -269,6 +286,17 @@ std::size_t apply_buffer_rules(const Orthtree<3>& t, Flags& in, const SurfaceBou
 /// without the buffer rule, with facing projections only, accept_valid_folds, one repair that
 /// makes things worse allowed, and no further retry.
 Options3d facing_try_options(const Options3d& opt);
+
+/// The options of the try with the thickness level (Options3d::refused_thickness_cells octants
+/// across the thin parts, up to level + thickness_extra_levels): `opt` without the buffer rule
+/// (its one-octant slabs in thin parts project through them), no level raise, its own work
+/// bound of thin_retry_effort first trees.
+Options3d thickness_try_options(const Options3d& opt);
+
+/// Is part of the solid thinner than Options3d::refused_thickness_cells octants of level + 1
+/// (where the thickness level passes the feature level, so that the thickness try's first tree
+/// is not the plain one)? False when refused_thickness_cells is 0.
+bool thickness_try_applies(SurfaceBoundary& s, const Options3d& opt);
 
 /// What a mesh of `s` is validated against (DESIGN.md, "Validity"): the solid's Euler
 /// characteristic is half the surface's (when that is even), and interface nodes lie on the

@@ -47,7 +47,7 @@ if not os.path.exists(path):
     sys.exit(0)
 r = json.load(open(path))
 c, q, f, v = r["counts"], r["quality"], r["fidelity"], r["validation"]
-notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal")
+notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal", "thickness_early")
          if r["options"].get(k)]
 status = "valid" if v["valid"] else "invalid"
 print(f"| {s} | {level} | {kind} | {status} | {q['n_elements']} | {c['tetrahedra']} | {q['min_dihedral_deg']:.2f} | "

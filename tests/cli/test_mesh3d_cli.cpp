@@ -115,3 +115,22 @@ TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores t
   CHECK(read_text(dir / "last" / "mesh.msh") != read_text(dir / "first" / "mesh.msh"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh3d --no-thickness-probe: the report says whether the probe ran and stood", "[cli][mesh3d]") {
+  // sphere966 at level 4: its first tree has no problem, so the probe (Options3d::thickness_probe)
+  // never runs and both meshes are the same; the report names the option and that it did not
+  // stand. Where it stands (spool level 6): test_real_data3d.cpp.
+  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_probe_" + std::to_string(::getpid()));
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  const std::string common = "mesh3d '" + sphere + "' --level 4 --quiet --threads 1 -o '";
+  REQUIRE(run_status(common + (dir / "probe").string() + "'") == 0);
+  REQUIRE(run_status(common + (dir / "none").string() + "' --no-thickness-probe") == 0);
+  const auto probe = nlohmann::json::parse(read_text(dir / "probe" / "report.json"));
+  const auto none = nlohmann::json::parse(read_text(dir / "none" / "report.json"));
+  CHECK(probe["options"]["thickness_probe"] == true);
+  CHECK(none["options"]["thickness_probe"] == false);
+  CHECK(probe["options"]["thickness_early"] == false);
+  CHECK(none["options"]["thickness_early"] == false);
+  CHECK(read_text(dir / "probe" / "mesh.msh") == read_text(dir / "none" / "mesh.msh"));
+  std::filesystem::remove_all(dir);
+}

@@ -4,6 +4,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -326,8 +327,10 @@ TEST_CASE("mesh3d tries without the buffer rule first, with facing projections n
 // The buffer rule's try, last, standing where the two before it are refused: voxel union seed 4,
 // case 81 of the survey, at level 3 (found in session 31 by counting the tries of 200 cases of
 // voxel seeds 4 and 5: it stood once and was refused six times). Without the thickness retry,
-// which replaces this mesh by default (it loses 10.7% of the volume; the CLI's mesh is the
-// retry's, the same as in the order before), so that the try's own mesh and flags are seen.
+// which replaced this mesh (it loses 10.7% of the volume), and without the thickness probe,
+// which makes the CLI's mesh since session 32 (59,373 tets, 19.67 deg, 4.91%, 0.84 s CPU,
+// instead of the retry's 98,262, 16.37 deg, 7.32%, 5.47 s), so that the try's own mesh and
+// flags are seen.
 TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused", "[pipeline3d]") {
   if (test::sanitized()) return;  // about 3 CPU s in Release (three tries)
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) +
@@ -336,6 +339,7 @@ TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused
   opt.level = 3;
   opt.n_threads = 1;
   opt.thin_retry_cells = 0;
+  opt.thickness_probe = false;
   Fallbacks f;
   const Result3d r = mesh3d(s, opt, f.progress());
   const std::vector<std::string> order = {"with facing projections only", "with the buffer rule"};
@@ -346,6 +350,46 @@ TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused
   CHECK_FALSE(r.features_dropped);
   CHECK(r.n_buffer_dropped > 0);
   CHECK(validate(r.fe.mesh, surface_validation(s)).valid);
+}
+
+// Options3d::thickness_probe: voxel union seed 4, case 50 of the survey, at level 3 (found in
+// session 32 with FEBEMESH_SURVEY_KEEP=thickness_early). Its first tree has problems at parts one
+// voxel thick; the first tree with 4 octants across them has none and stands. Without the probe
+// the first try's repairs stand and lose 10.3% of the volume, and the thickness retry keeps its
+// mesh (thickness_refined, CLI: 40,415 tets, 17.16 deg, 10.31%, 1.08 s CPU); with it, 55,533
+// tets, 19.97 deg, 4.80%, 0.68 s.
+TEST_CASE("mesh3d's thickness probe stands where the first tree has problems at thin parts", "[pipeline3d]") {
+  const std::string file =
+      std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-seed4-case50-thickness-early.off";
+  // Under the sanitizers the run with the probe only (without it: 1 CPU s in Release).
+  const std::vector<bool> probes = test::sanitized() ? std::vector<bool>{true} : std::vector<bool>{true, false};
+  double error[2] = {1.0, 1.0};
+  for (const bool probe : probes) {
+    SurfaceBoundary s = SurfaceBoundary::from_file(file);
+    Options3d opt;
+    opt.level = 3;
+    opt.n_threads = 1;
+    opt.thickness_probe = probe;
+    std::vector<std::string> lines;
+    const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+    const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+    INFO("probe " << probe << ": " << v.summary());
+    CHECK(v.valid);
+    CHECK(r.thickness_early == probe);
+    CHECK(r.thickness_refined == !probe);
+    const bool probed = std::any_of(lines.begin(), lines.end(), [](const std::string& m) {
+      return m.find("the first tree with the thickness level stands") != std::string::npos;
+    });
+    CHECK(probed == probe);
+    if (probe) {
+      // The validator's report comes with the mesh (the CLI does not validate again).
+      REQUIRE(r.validation);
+      CHECK(r.validation_hash == content_hash(r.fe.mesh));
+    }
+    error[probe ? 0 : 1] = std::abs(solid_measure<3>(r.fe.mesh) - s.volume()) / s.volume();
+  }
+  CHECK(error[0] < 0.06);
+  if (!test::sanitized()) CHECK(error[0] < error[1]);
 }
 
 // Options3d::skip_repeated_rounds on the voxel union of the island trial at level 4: in its first
@@ -471,29 +515,36 @@ TEST_CASE("tet_optimize untangles a displaced centre node and keeps the corners"
 
 // Threads (issue 8): the projections of the boundary octants, the classification, the smoothing
 // and the tet optimiser run on opt.n_threads; the mesh and the counts must not depend on it.
-// Spool at level 3 without the thickness retry: the first tree's projections include next
-// local minima (22 of them, diagnose3d; the retry's tree had 4 while the thickness was measured
-// at the centroids only, none since it is the thinnest of centroid and vertices).
+// Spool at level 3 without the thickness retry and the thickness probe: the first tree's
+// projections include next local minima (22 of them, diagnose3d; the retry's tree had 4 while
+// the thickness was measured at the centroids only, none since it is the thinnest of centroid and
+// vertices). With the probe (the default), whose tree stands there, as well.
 TEST_CASE("mesh3d gives the same mesh and counts on 1 and 2 threads", "[pipeline3d][threads]") {
-  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off");
-  Options3d opt;
-  opt.level = 3;
-  opt.thin_retry_cells = 0;
-  opt.n_threads = 1;
-  const Result3d one = mesh3d(s, opt);
-  opt.n_threads = 2;
-  const Result3d two = mesh3d(s, opt);
-  REQUIRE(one.fe.mesh.solid.size() > 10000);
-  CHECK(one.stats.n_next_normal > 0);
-  CHECK(one.fe.mesh.points == two.fe.mesh.points);  // bit for bit
-  CHECK(one.fe.mesh.solid.node == two.fe.mesh.solid.node);
-  CHECK(one.fe.mesh.interface.node == two.fe.mesh.interface.node);
-  CHECK(one.stats.n_surface_nodes == two.stats.n_surface_nodes);
-  CHECK(one.stats.n_shared_projections == two.stats.n_shared_projections);
-  CHECK(one.stats.n_next_normal == two.stats.n_next_normal);
-  CHECK(one.stats.n_ray == two.stats.n_ray);
-  CHECK(one.stats.n_blind == two.stats.n_blind);
-  CHECK(one.n_optimize_moves == two.n_optimize_moves);
+  for (const bool probe : {false, true}) {
+    INFO("thickness probe " << probe);
+    SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off");
+    Options3d opt;
+    opt.level = 3;
+    opt.thin_retry_cells = 0;
+    opt.thickness_probe = probe;
+    opt.n_threads = 1;
+    const Result3d one = mesh3d(s, opt);
+    opt.n_threads = 2;
+    const Result3d two = mesh3d(s, opt);
+    REQUIRE(one.fe.mesh.solid.size() > 10000);
+    CHECK(one.thickness_early == probe);
+    CHECK(two.thickness_early == probe);
+    if (!probe) CHECK(one.stats.n_next_normal > 0);
+    CHECK(one.fe.mesh.points == two.fe.mesh.points);  // bit for bit
+    CHECK(one.fe.mesh.solid.node == two.fe.mesh.solid.node);
+    CHECK(one.fe.mesh.interface.node == two.fe.mesh.interface.node);
+    CHECK(one.stats.n_surface_nodes == two.stats.n_surface_nodes);
+    CHECK(one.stats.n_shared_projections == two.stats.n_shared_projections);
+    CHECK(one.stats.n_next_normal == two.stats.n_next_normal);
+    CHECK(one.stats.n_ray == two.stats.n_ray);
+    CHECK(one.stats.n_blind == two.stats.n_blind);
+    CHECK(one.n_optimize_moves == two.n_optimize_moves);
+  }
 }
 
 // Backward projections (issue 6, BoundaryOctantOptions::unfold_backward, off by default): a

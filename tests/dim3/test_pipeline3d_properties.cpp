@@ -272,10 +272,33 @@ TEST_CASE("the 3D FE volume approaches the surface's volume as the level rises",
 
 // ---- survey: how many cases of a family fail, without stopping at the first (hidden) ----
 
+namespace {
+
+/// The fallbacks that made a mesh (Result3d's flags, report.json's names), comma-separated.
+std::string fallbacks_of(const Result3d& r) {
+  std::string out;
+  const std::pair<bool, const char*> flags[] = {{r.buffer_dropped, "buffer_rule_dropped"},
+                                                {r.buffer_fallback, "buffer_rule_fallback"},
+                                                {r.features_dropped, "feature_snapping_dropped"},
+                                                {r.facing_projection, "facing_projection"},
+                                                {r.thickness_refined, "thickness_refined"},
+                                                {r.thickness_after_refusal, "thickness_after_refusal"},
+                                                {r.thickness_early, "thickness_early"},
+                                                {r.thin_parts_coarse, "thin_parts_coarse"},
+                                                {r.level_raised > 0, "level_raised"}};
+  for (const auto& [set, name] : flags)
+    if (set) out += (out.empty() ? "" : ",") + std::string(name);
+  return out;
+}
+
+}  // namespace
+
 // FEBEMESH_SURVEY=sphere1|torus|voxel FEBEMESH_SURVEY_CASES=N [FEBEMESH_SURVEY_DIR=DIR]
-// [RC_PARAMS="seed=S"] test_dim3 "[.survey]": runs N generated cases of the family (the same
-// generators and sizes as the properties above), prints every refused or invalid one and, with
-// FEBEMESH_SURVEY_DIR, writes it there as an OFF file (unshrunk). Never fails: it measures.
+// [FEBEMESH_SURVEY_KEEP=FLAG] [RC_PARAMS="seed=S"] test_dim3 "[.survey]": runs N generated cases
+// of the family (the same generators and sizes as the properties above), prints every case with
+// the fallbacks that made its mesh, every refused or invalid one with why and, with
+// FEBEMESH_SURVEY_DIR, writes those there as OFF files (unshrunk), and the valid ones whose
+// fallbacks include FEBEMESH_SURVEY_KEEP (e.g. thickness_early). Never fails: it measures.
 TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
   const char* kind = std::getenv("FEBEMESH_SURVEY");
   if (!kind) return;
@@ -286,6 +309,7 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
                                                    : test::gen_sphere_spec(1);
   const char* cases_env = std::getenv("FEBEMESH_SURVEY_CASES");
   const char* dir = std::getenv("FEBEMESH_SURVEY_DIR");
+  const char* keep = std::getenv("FEBEMESH_SURVEY_KEEP");
   rc::detail::TestParams params = rc::detail::configuration().testParams;
   params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
   params.disableShrinking = true;
@@ -297,11 +321,12 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
       [&] {
         const SurfaceSpec spec = *gen;
         const long index = n++;
-        std::string why;
+        std::string why, how;
         const auto t0 = std::chrono::steady_clock::now();
         try {
           const Outcome3 out = run_surface(test::to_surface(spec), spec.level);
           ++tally.cases;
+          how = fallbacks_of(out.r);
           if (!out.v.valid) why = "INVALID: " + out.v.summary();
           else if (std::abs(out.fe_volume - out.be_volume) > out.round_off) why = "volume gap";
         } catch (const GeometryError& e) {
@@ -310,7 +335,10 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
           why = std::string("LimitError: ") + e.what();
         }
         const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("[survey] case %ld %s %.1f s\n", index, why.empty() ? "ok" : "FAILED", sec);
+        std::printf("[survey] case %ld %s %.1f s%s\n", index, why.empty() ? "ok" : "FAILED", sec,
+                    how.empty() ? "" : (" (" + how + ")").c_str());
+        if (why.empty() && dir && keep && ("," + how + ",").find("," + std::string(keep) + ",") != std::string::npos)
+          std::ofstream(fs::path(dir) / (k + "-" + std::to_string(index) + ".off")) << test::to_off(spec);
         if (!why.empty()) {
           ++failed;
           std::printf("[survey] case %ld FAILED: %s\n  %s\n", index, test::describe(spec).c_str(), why.c_str());
