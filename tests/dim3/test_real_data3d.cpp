@@ -150,7 +150,7 @@ TEST_CASE("mesh3d data: spool level 6 with 4 octants across its thin parts (vali
   // The first tree has problems, so mesh3d builds the first tree with 4 octants across every
   // part (Options3d::thickness_probe: the thinnest of centroid and vertices,
   // SurfaceBoundary::thickness), up to level 8, no buffer rule; it has none and stands.
-  // Measured (CLI, one thread): 3,186,690 tets, 15.85 deg, 0.16%, 28 s CPU, 680 MB; the
+  // Measured (CLI, one thread): 3,186,690 tets, 15.85 deg, 0.16%, 28 s CPU, 664 MB; the
   // same mesh.msh as the thickness try after every refusal before it.
   Options3d opt;
   opt.level = 6;
