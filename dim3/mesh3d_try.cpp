@@ -142,6 +142,7 @@ struct RepairLoop {
   int trial_attempts = 0;  // attempts spent on a reverted trial
   std::optional<Classified> classified;
   bool first_of_run = false;  // this loop's first tree is its run's first (Effort::first_tree_built)
+  bool tetrahedra_built = false;  // make_tetrahedra has run on a tree of this loop
 
   RepairLoop(SurfaceBoundary& surface, const Options3d& options, Effort& work, const Progress3& say_to)
       : s(surface), opt(options), effort(work), progress(say_to) {}
@@ -402,7 +403,7 @@ struct RepairLoop {
           untangle_pass(tm.fe, tm.oc.complex, opt.untangle_sweeps, false, surface_point, surface_normal, opt.n_threads, bounds);
       r.n_untangle_moves += ts.moves;
       say(untangle_summary("untangling", ts));
-      if (round == 0 && opt.first_round_inverted_share > 0 &&
+      if (round == 0 && !std::exchange(tetrahedra_built, true) && opt.first_round_inverted_share > 0 &&
           static_cast<double>(ts.inverted_after) > opt.first_round_inverted_share * static_cast<double>(ts.inverted_before))
         throw GeometryError("the first round of untangling left " + std::to_string(ts.inverted_after) + " of " +
                             std::to_string(ts.inverted_before) + " tetrahedra inverted");

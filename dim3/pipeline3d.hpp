@@ -190,11 +190,13 @@ struct Options3d {
   /// elephant L4-L6 and fandisk L4-L6 have problems, so their meshes stay the same, at the
   /// probe's cost (0.0-0.6 s CPU with first_round_inverted_share's early end).
   bool thickness_probe = true;
-  /// The probe's early end: a try whose first round of untangling leaves more than this share
-  /// of its tetrahedra inverted at the templates is refused there (GeometryError); 0 = off (every
-  /// try but the probe). Measured (first rounds at the thickness level): spool L6 16106 -> 19
-  /// (0.1%, it stands); anchor L4 34%, fandisk L4 6%, fandisk L5 8%, elephant L4 5% (all refused
-  /// after their nine rounds and the Escobar pass).
+  /// The probe's early end: a try whose first tree's first round of untangling leaves more than
+  /// this share of its tetrahedra inverted at the templates is refused there (GeometryError); 0 =
+  /// off (every try but the probe). Measured (first rounds at the thickness level): spool L6
+  /// 16106 -> 19 (0.1%, it stands); anchor L4 34%, fandisk L4 6%, fandisk L5 8%, elephant L4 5%
+  /// (all refused after their nine rounds and the Escobar pass). Not a rule for the thin retry
+  /// (thin_retry_cells): at 2% (8%) its tries ended early on rotor L5 (60 -> 17 s CPU, the same
+  /// mesh), but 30 (19) of the 35 retries that stood in 200 voxel survey cases (seed 4) were lost.
   double first_round_inverted_share = 0.0;
   /// When that try is refused too (or not run), once more without what refines the thin parts
   /// to 1-3 octants across: no feature level (SurfaceOptions::feature_extra_levels 0: on a
