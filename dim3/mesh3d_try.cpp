@@ -763,12 +763,18 @@ struct RepairLoop {
       if (over_work_bound()) return restore_saved();
       build_boundary_octants(tm);
       if (tm.problems.empty()) make_tetrahedra(tm);
-      if (refine_for_topology_before_quality(tm)) continue;
+      if (refine_for_topology_before_quality(tm)) {
+        first_of_run = false;  // the probe looks at the run's first tree only
+        continue;
+      }
       if (tm.problems.empty()) improve_and_check(tm);
       if (tm.problems.empty() && topology_refinements < opt.topology_refinements && !tm.last) {
         std::optional<long> euler;
         if (!tm.topology_right) euler = euler_characteristic<3>(tm.fe.mesh, opt.n_threads);
-        if (refine_surface_octants(tm, true, euler)) continue;
+        if (refine_surface_octants(tm, true, euler)) {
+          first_of_run = false;
+          continue;
+        }
       }
       if (tm.problems.empty()) return finish(tm);
       if (std::optional<Result3d> thick = thickness_probe()) return std::move(*thick);
