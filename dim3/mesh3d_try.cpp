@@ -717,7 +717,7 @@ struct RepairLoop {
     thick.max_repairs = 0;
     thick.first_round_inverted_share = 0.02;
     say("the first tree has problems and the solid has thin parts: the first tree with " +
-        std::to_string(thick.thickness_cells) + " octants across them, without the buffer rule and without a repair");
+        octants_across(thick.thickness_cells) + " them, without the buffer rule and without a repair");
     std::optional<Result3d> stands;
     Effort own;
     try {

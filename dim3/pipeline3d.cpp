@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -161,6 +162,12 @@ bool thickness_try_applies(SurfaceBoundary& s, const Options3d& opt) {
   return s.thin_share(cells * h_feature) > 0;
 }
 
+std::string octants_across(double cells) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", cells);
+  return std::string(text) + " octants across";
+}
+
 namespace {
 
 /// |volume of the solid elements - the surface's| / the surface's.
@@ -246,14 +253,14 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   after.min_effort_octants = 0;
   after.thickness_probe = false;
   if (progress)
-    progress(std::string("refused (") + e.what() + "): once more with " + std::to_string(cells) +
-             " octants across the thin parts, without the buffer rule");
+    progress(std::string("refused (") + e.what() + "): once more with " + octants_across(cells) +
+             " the thin parts, without the buffer rule");
   if (std::optional<Result3d> t = try_after_refusal(s, thick, effort, why, progress)) {
     t->thickness_after_refusal = true;
     return std::move(*t);
   }
   s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
-  reasons += "; with " + std::to_string(cells) + " octants across the thin parts: " + why;
+  reasons += "; with " + octants_across(cells) + " the thin parts: " + why;
   if (!opt.coarse_thin_after_refusal) throw E(reasons);
   Options3d coarse = after;
   coarse.island_refinements = 0;
@@ -310,8 +317,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   thin.effort = std::min(ran.effort, ran.thin_retry_effort);
   thin.min_effort_octants = 0;
   if (progress)
-    progress("volume error " + std::to_string(100 * error) + "%: once more with " + std::to_string(thin.thickness_cells) +
-             " octants across the thin parts, without the buffer rule");
+    progress("volume error " + std::to_string(100 * error) + "%: once more with " + octants_across(thin.thickness_cells) +
+             " the thin parts, without the buffer rule");
   Effort thin_effort;
   try {
     Result3d t = mesh3d_tries(s, thin, thin_effort, progress);

@@ -300,6 +300,9 @@ Options3d thickness_try_options(const Options3d& opt);
 /// is not the plain one)? False when refused_thickness_cells is 0.
 bool thickness_try_applies(SurfaceBoundary& s, const Options3d& opt);
 
+/// "N octants across", N as short as %g prints it (4, 2.5): the thickness tries' messages.
+std::string octants_across(double cells);
+
 /// What a mesh of `s` is validated against (DESIGN.md, "Validity"): the solid's Euler
 /// characteristic is half the surface's (when that is even), and interface nodes lie on the
 /// surface within 1e-10 of its diagonal. The options refer to `s`, which must outlive them.

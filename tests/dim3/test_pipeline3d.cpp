@@ -141,6 +141,7 @@ TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part"
   CHECK(with.find("over its work bound") != std::string::npos);
   CHECK(with.find("octants across the thin parts: the boundary octants could not be built within the work bound") !=
         std::string::npos);
+  CHECK(with.find("; with 4 octants across the thin parts: ") != std::string::npos);  // not "4.000000"
   CHECK(with.find("; without the feature level: ") != std::string::npos);  // coarse_thin_after_refusal
   INFO(without);
   CHECK(without.find("over its work bound") != std::string::npos);
