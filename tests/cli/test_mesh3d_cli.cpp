@@ -28,6 +28,24 @@ std::string read_text(const std::filesystem::path& p) {
   return ss.str();
 }
 
+/// sphere966 meshed at `level` on one thread twice, into dir/a with the default options and into
+/// dir/b with `b_options` (the ways the CLI's switches are compared); both runs must exit 0.
+struct SpherePair {
+  std::filesystem::path dir;
+  SpherePair(const std::string& name, int level, const std::string& b_options)
+      : dir(std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_" + name + "_" + std::to_string(::getpid()))) {
+    const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+    const std::string common = "mesh3d '" + sphere + "' --level " + std::to_string(level) + " --quiet --threads 1 -o '";
+    REQUIRE(run_status(common + (dir / "a").string() + "'") == 0);
+    REQUIRE(run_status(common + (dir / "b").string() + "' " + b_options) == 0);
+  }
+  ~SpherePair() { std::filesystem::remove_all(dir); }
+  SpherePair(const SpherePair&) = delete;
+  SpherePair& operator=(const SpherePair&) = delete;
+  std::filesystem::path msh(const char* run) const { return dir / run / "mesh.msh"; }
+  nlohmann::json report(const char* run) const { return nlohmann::json::parse(read_text(dir / run / "report.json")); }
+};
+
 /// Meshes `input` at level 4 on 1 and 2 threads into dir/1 and dir/2 and checks that the two
 /// mesh.msh are the same, byte for byte.
 void check_same_mesh_on_1_and_2_threads(const std::string& input, const std::filesystem::path& dir) {
@@ -74,35 +92,25 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads with features and slidi
 }
 
 TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary", "[cli][mesh3d]") {
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_binary_" + std::to_string(::getpid()));
-  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
-  const std::string common = "mesh3d '" + sphere + "' --level 3 --quiet --threads 1 -o '";
-  REQUIRE(run_status(common + (dir / "ascii").string() + "'") == 0);
-  REQUIRE(run_status(common + (dir / "binary").string() + "' --binary") == 0);
-  const std::string ascii = read_text(dir / "ascii" / "mesh.msh"), binary = read_text(dir / "binary" / "mesh.msh");
+  const SpherePair runs("binary", 3, "--binary");  // a: ASCII, b: binary
+  const std::string ascii = read_text(runs.msh("a")), binary = read_text(runs.msh("b"));
   CHECK(binary.find("$MeshFormat\n4.1 1 8\n") == 0);
   CHECK(binary != ascii);
   // Read back, both give the mesh, bit for bit (the ASCII writer's doubles round-trip).
-  const febemesh::Mesh<3> a = febemesh::read_msh<3>(dir / "ascii" / "mesh.msh");
-  const febemesh::Mesh<3> b = febemesh::read_msh<3>(dir / "binary" / "mesh.msh");
+  const febemesh::Mesh<3> a = febemesh::read_msh<3>(runs.msh("a"));
+  const febemesh::Mesh<3> b = febemesh::read_msh<3>(runs.msh("b"));
   CHECK(a.solid.size() > 1000);
   CHECK(febemesh::msh_string(a) == febemesh::msh_string(b));
-  CHECK(nlohmann::json::parse(read_text(dir / "binary" / "report.json"))["options"]["msh_encoding"] == "binary");
-  CHECK(nlohmann::json::parse(read_text(dir / "ascii" / "report.json"))["options"]["msh_encoding"] == "ascii");
-  std::filesystem::remove_all(dir);
+  CHECK(runs.report("b")["options"]["msh_encoding"] == "binary");
+  CHECK(runs.report("a")["options"]["msh_encoding"] == "ascii");
 }
 
 TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores the buffer rule's try first", "[cli][mesh3d]") {
   // sphere966 at level 4: every try stands at once, so the first try of each order makes the
   // mesh: without the buffer rule by default (no octant dropped by it), with it under
   // --buffer-first (octants dropped). Both valid; the report says which order ran.
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_order_" + std::to_string(::getpid()));
-  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
-  const std::string common = "mesh3d '" + sphere + "' --level 4 --quiet --threads 1 -o '";
-  REQUIRE(run_status(common + (dir / "last").string() + "'") == 0);
-  REQUIRE(run_status(common + (dir / "first").string() + "' --buffer-first") == 0);
-  const auto last = nlohmann::json::parse(read_text(dir / "last" / "report.json"));
-  const auto first = nlohmann::json::parse(read_text(dir / "first" / "report.json"));
+  const SpherePair runs("order", 4, "--buffer-first");
+  const auto last = runs.report("a"), first = runs.report("b");
   CHECK(last["options"]["buffer_last"] == true);
   CHECK(first["options"]["buffer_last"] == false);
   CHECK(last["counts"]["buffer_dropped"] == 0);
@@ -112,25 +120,18 @@ TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores t
     CHECK((*r)["options"]["buffer_rule_fallback"] == false);
     CHECK((*r)["options"]["buffer_rule_dropped"] == false);
   }
-  CHECK(read_text(dir / "last" / "mesh.msh") != read_text(dir / "first" / "mesh.msh"));
-  std::filesystem::remove_all(dir);
+  CHECK(read_text(runs.msh("a")) != read_text(runs.msh("b")));
 }
 
 TEST_CASE("mesh3d --no-thickness-probe: the report says whether the probe ran and stood", "[cli][mesh3d]") {
   // sphere966 at level 4: its first tree has no problem, so the probe (Options3d::thickness_probe)
   // never runs and both meshes are the same; the report names the option and that it did not
   // stand. Where it stands (spool level 6): test_real_data3d.cpp.
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_probe_" + std::to_string(::getpid()));
-  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
-  const std::string common = "mesh3d '" + sphere + "' --level 4 --quiet --threads 1 -o '";
-  REQUIRE(run_status(common + (dir / "probe").string() + "'") == 0);
-  REQUIRE(run_status(common + (dir / "none").string() + "' --no-thickness-probe") == 0);
-  const auto probe = nlohmann::json::parse(read_text(dir / "probe" / "report.json"));
-  const auto none = nlohmann::json::parse(read_text(dir / "none" / "report.json"));
+  const SpherePair runs("probe", 4, "--no-thickness-probe");
+  const auto probe = runs.report("a"), none = runs.report("b");
   CHECK(probe["options"]["thickness_probe"] == true);
   CHECK(none["options"]["thickness_probe"] == false);
   CHECK(probe["options"]["thickness_early"] == false);
   CHECK(none["options"]["thickness_early"] == false);
-  CHECK(read_text(dir / "probe" / "mesh.msh") == read_text(dir / "none" / "mesh.msh"));
-  std::filesystem::remove_all(dir);
+  CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));
 }
