@@ -149,6 +149,13 @@ struct RepairLoop {
   RepairLoop(const RepairLoop&) = delete;
   RepairLoop& operator=(const RepairLoop&) = delete;
 
+  /// The surface's level field from opt: global, feature and thickness levels.
+  void surface_levels() {
+    s.set_global_level(opt.level);
+    s.set_max_level(opt.level + opt.extra_levels);
+    s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+  }
+
   /// The surface's levels from opt, and the first tree: subdivided by the level field and 2:1
   /// balanced. Sets the work bound when the run has none yet.
   void first_tree() {
@@ -157,9 +164,7 @@ struct RepairLoop {
                 : opt.thickness_cells > 0
                     ? std::max(opt.level + opt.extra_levels + 2, thickness_max_level)
                     : opt.level + opt.extra_levels + 2;
-    s.set_global_level(opt.level);
-    s.set_max_level(opt.level + opt.extra_levels);
-    s.set_thickness_level(opt.thickness_cells, thickness_max_level);
+    surface_levels();
     RefineOptions ro;
     ro.max_level = max_level;
     ro.max_leaves = opt.max_cells;
@@ -723,12 +728,7 @@ struct RepairLoop {
     try {
       RepairLoop probe(s, thick, own, progress);
       Result3d t = probe.run();
-      ValidationReport v = t.validation && t.validation_hash == content_hash(t.fe.mesh)
-                               ? *t.validation
-                               : validate(t.fe.mesh, surface_validation(s, opt.n_threads));
-      if (v.valid) {
-        t.validation = std::move(v);
-        t.validation_hash = content_hash(t.fe.mesh);
+      if (const ValidationReport& v = validation_of(t, s, opt.n_threads); v.valid) {
         t.thickness_early = true;
         std::vector<StageTime3> times = r.times;
         times.insert(times.end(), t.times.begin(), t.times.end());
@@ -745,9 +745,7 @@ struct RepairLoop {
           "); going on");
     }
     effort.used += own.used;
-    s.set_global_level(opt.level);
-    s.set_max_level(opt.level + opt.extra_levels);
-    s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
+    surface_levels();
     return stands;
   }
 

@@ -76,6 +76,15 @@ ValidateOptions<3> surface_validation(const SurfaceBoundary& s, int n_threads) {
   return vo;
 }
 
+const ValidationReport& validation_of(Result3d& r, const SurfaceBoundary& s, int n_threads) {
+  const std::uint64_t hash = content_hash(r.fe.mesh);
+  if (!r.validation || r.validation_hash != hash) {
+    r.validation = validate(r.fe.mesh, surface_validation(s, n_threads));
+    r.validation_hash = hash;
+  }
+  return *r.validation;
+}
+
 namespace {
 
 Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
@@ -323,14 +332,12 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   try {
     Result3d t = mesh3d_tries(s, thin, thin_effort, progress);
     t.n_octants_built = r.n_octants_built + thin_effort.used;
-    const ValidationReport v = validate(t.fe.mesh, surface_validation(s, opt.n_threads));
+    const ValidationReport& v = validation_of(t, s, opt.n_threads);
     const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);
     if (progress)
       progress("thin parts: the mesh is " + std::string(v.valid ? "valid" : "not valid (" + v.summary() + ")") +
                ", volume error " + std::to_string(100 * t_error) + "%");
     if (v.valid && t_error < error) {
-      t.validation = v;
-      t.validation_hash = content_hash(t.fe.mesh);
       t.thickness_refined = true;
       t.level_raised = r.level_raised;
       std::vector<StageTime3> times = std::move(r.times);

@@ -309,4 +309,9 @@ std::string octants_across(double cells);
 /// On n_threads threads (the same report on any count).
 ValidateOptions<3> surface_validation(const SurfaceBoundary& s, int n_threads = 1);
 
+/// The validator's report of r.fe.mesh with surface_validation(s, n_threads): the pipeline's own
+/// when r carries one of this mesh (Result3d::validation and its content hash), else validated
+/// now; r carries it afterwards (the CLI then does not validate again).
+const ValidationReport& validation_of(Result3d& r, const SurfaceBoundary& s, int n_threads);
+
 }  // namespace febemesh::dim3
