@@ -736,11 +736,14 @@ struct RepairLoop {
         stands = std::move(t);
         say("thin parts: the first tree with the thickness level stands");
       } else {
+        effort.thickness_probe_refused = "not valid: " + v.summary();
         say("thin parts: the first tree with the thickness level is not valid (" + v.summary() + "); going on");
       }
     } catch (const GeometryError& e) {
+      effort.thickness_probe_refused = e.what();
       say(std::string("thin parts: the first tree with the thickness level has problems (") + e.what() + "); going on");
     } catch (const LimitError& e) {
+      effort.thickness_probe_refused = e.what();
       say(std::string("thin parts: the first tree with the thickness level is over its bounds (") + e.what() +
           "); going on");
     }

@@ -5,6 +5,7 @@
 // problems drops or refines octants around them and builds again.
 
 #include <cstddef>
+#include <string>
 
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_boundary.hpp"
@@ -17,6 +18,9 @@ struct Effort {
   std::size_t used = 0;
   std::size_t limit = 0;
   bool first_tree_built = false;  ///< the run's first tree (Options3d::thickness_probe looks at it only)
+  /// Why the probe did not stand, when it ran (Options3d::thickness_probe): the thickness try
+  /// after a refusal would begin with the probe's tree again. Empty: no probe, or it stood.
+  std::string thickness_probe_refused;
 };
 
 /// One try of the pipeline with `opt` (no fallback): `s` gets the options' levels, `effort`

@@ -261,12 +261,23 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   after.effort = thick.effort;
   after.min_effort_octants = 0;
   after.thickness_probe = false;
-  if (progress)
-    progress(std::string("refused (") + e.what() + "): once more with " + octants_across(cells) +
-             " the thin parts, without the buffer rule");
-  if (std::optional<Result3d> t = try_after_refusal(s, thick, effort, why, progress)) {
-    t->thickness_after_refusal = true;
-    return std::move(*t);
+  if (!effort.thickness_probe_refused.empty()) {
+    // Its first tree is the probe's, which did not stand. Measured: rotor L6 spent 272 s of its
+    // 1,069 s wall on this try's repairs after the probe's first round had left 6% inverted
+    // (refused by its work bound); in 800 survey cases (voxel seeds 4 and 5, tori 11 and 12)
+    // this try never stood.
+    why = "its first tree is the thickness probe's: " + effort.thickness_probe_refused;
+    if (progress)
+      progress(std::string("refused (") + e.what() + "): not once more with " + octants_across(cells) +
+               " the thin parts (" + why + ")");
+  } else {
+    if (progress)
+      progress(std::string("refused (") + e.what() + "): once more with " + octants_across(cells) +
+               " the thin parts, without the buffer rule");
+    if (std::optional<Result3d> t = try_after_refusal(s, thick, effort, why, progress)) {
+      t->thickness_after_refusal = true;
+      return std::move(*t);
+    }
   }
   s.set_thickness_level(opt.thickness_cells, opt.level + opt.thickness_extra_levels);
   reasons += "; with " + octants_across(cells) + " the thin parts: " + why;

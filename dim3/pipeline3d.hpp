@@ -179,6 +179,8 @@ struct Options3d {
   /// flange's lip tapers from 0.022 to 0.010, 1-3 level-7 octants: refused after 795 s CPU):
   /// with 4 octants across, up to level 8, the first try is valid without a repair (diagnose3d
   /// --single --buffer 0: 3,186,715 tets, 11.05 deg, 0.16% volume error, 32 s CPU, 737 MB).
+  /// Not run where thickness_probe built its first tree and it did not stand (Effort::
+  /// thickness_probe_refused): the coarse try below comes next.
   double refused_thickness_cells = 4.0;
   /// Where that try would run (thin parts, as for refused_thickness_cells) and the run's first
   /// tree leaves problems after its untangling, the first tree of that try is built at once,

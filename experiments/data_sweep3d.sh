@@ -47,8 +47,10 @@ if not os.path.exists(path):
     sys.exit(0)
 r = json.load(open(path))
 c, q, f, v = r["counts"], r["quality"], r["fidelity"], r["validation"]
-notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal", "thickness_early")
+notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal", "thickness_early", "thin_parts_coarse")
          if r["options"].get(k)]
+if r["options"].get("level_raised"):
+    notes.append(f"level_raised {r['options']['level_raised']}")
 status = "valid" if v["valid"] else "invalid"
 print(f"| {s} | {level} | {kind} | {status} | {q['n_elements']} | {c['tetrahedra']} | {q['min_dihedral_deg']:.2f} | "
       f"{100 * f['volume_rel_error']:.2f}% | {f['hausdorff_rel']:.2e} | {cpu:.1f} | {mb:.0f} | {', '.join(notes)} |")
