@@ -49,6 +49,9 @@ const char* help_text =
     "  --smooth N          smoothing iterations (0..50, default 4)\n"
     "  --no-features       do not snap to feature edges and corners (also skipped on a\n"
     "                      faceted surface, where most feature lines end in smooth surface)\n"
+    "  --given-axes        mesh in the input's axes (by default a part whose flat faces lie\n"
+    "                      at an angle to them is meshed in the frame of those faces and\n"
+    "                      turned back: report.json \"frame\")\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -96,7 +99,7 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
-                   "--no-thickness-probe", "--allow-invalid",
+                   "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort"});
   args.expect_positional({"SURFACE"});
@@ -118,6 +121,7 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for comparisons with the tries before session 32: no thickness try's first tree
   // after a first tree with problems (Options3d::thickness_probe off).
   opt.thickness_probe = !args.has("--no-thickness-probe");
+  opt.align_planar_faces = !args.has("--given-axes");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
@@ -195,7 +199,18 @@ int run(const std::vector<std::string>& argv) {
                     {"thickness_after_refusal", r.thickness_after_refusal},
                     {"thin_parts_coarse", r.thin_parts_coarse},
                     {"thickness_early", r.thickness_early},
-                    {"level_raised", r.level_raised}};
+                    {"level_raised", r.level_raised},
+                    {"align_planar_faces", opt.align_planar_faces},
+                    {"frame_turned", r.frame.turned},
+                    {"frame_refused", r.frame_refused}};
+  // The frame meshed in (Options3d::align_planar_faces): its axes as rows, in the input's
+  // coordinates, and the share of the area on planes square to them and to the given axes.
+  nlohmann::json axes = nlohmann::json::array();
+  for (int k = 0; k < 3; ++k) axes.push_back({r.frame.to_frame(k, 0), r.frame.to_frame(k, 1), r.frame.to_frame(k, 2)});
+  rep["frame"] = {{"turned", r.frame.turned},
+                  {"axes", axes},
+                  {"planar_share_given", r.frame.share_given},
+                  {"planar_share_frame", r.frame.share_frame}};
   rep["surface"] = {{"triangles", surface.triangles().size()},
                     {"euler_characteristic", surface.euler_characteristic()},
                     {"components", surface.n_components()},

@@ -17,6 +17,7 @@
 #include "core/validate.hpp"
 #include "dim3/boundary_octants.hpp"
 #include "dim3/hex_dominant.hpp"
+#include "dim3/planar_frame.hpp"
 #include "dim3/surface_boundary.hpp"
 #include "dim3/templates3d.hpp"
 
@@ -223,6 +224,13 @@ struct Options3d {
   /// coarse level for the shape), mesh3d tries up to this many levels finer, each within
   /// min_effort_octants octants (Result3d::level_raised). 0: refuse instead.
   int raise_levels = 1;
+  /// Mesh in the frame of the surface's planar faces when it puts 10% more of the area on
+  /// planes square to an axis than the given axes do (dim3/planar_frame.hpp), and turn the mesh
+  /// back: a machined part given at an angle is meshed as if given aligned. Surfaces without
+  /// such faces (elephant, sphere966) and aligned parts are meshed in their own axes, unchanged.
+  /// When every try in the frame is refused, the run is made again in the given axes
+  /// (Result3d::frame_refused).
+  bool align_planar_faces = true;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;
@@ -262,6 +270,10 @@ struct Result3d {
   std::size_t n_edges_contracted = 0;  ///< edges contracted there (contract_edges_below_deg)
   std::size_t n_concave_swaps = 0;  ///< of the edges removed, concave surface edges (EdgeRemovalOptions::concave_below_deg)
   HexDominantStats hex;              ///< with opt.hex_dominant
+  /// The frame meshed in (Options3d::align_planar_faces); with that option off, not turned, but
+  /// share_frame says what the frame would have put on its planes.
+  PlanarFrame frame;
+  bool frame_refused = false;        ///< every try in the frame was refused; this run is in the given axes
   std::vector<StageTime3> times;
   /// validate(fe.mesh, surface_validation(s)) where the pipeline made it of the mesh it returns
   /// (after the Escobar pass, with folds pending, the thickness retry), with content_hash of

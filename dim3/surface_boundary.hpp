@@ -91,6 +91,8 @@ class SurfaceBoundary final : public Boundary<3> {
   double area() const { return surface_.area(); }
   const Features& features() const { return features_; }
   const AabbTree& tree() const { return tree_; }
+  /// The options as they are now (the levels set since construction included).
+  const SurfaceOptions& options() const { return options_; }
   /// Smallest cube around the bounding box, enlarged by 5%, same centre, shifted by
   /// SurfaceOptions::root_shift.
   Box<3> root_box() const;

@@ -2,6 +2,7 @@
 // work bounds) are bad usage.
 
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -134,4 +135,49 @@ TEST_CASE("mesh3d --no-thickness-probe: the report says whether the probe ran an
   CHECK(probe["options"]["thickness_early"] == false);
   CHECK(none["options"]["thickness_early"] == false);
   CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));
+}
+
+TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in its own", "[cli][mesh3d]") {
+  // A box 1 x 0.6 x 0.3 turned by 30 degrees about z and 40 about x: every face at an angle to
+  // the given axes (Options3d::align_planar_faces, dim3/planar_frame.hpp).
+  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_frame_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const double cz = std::cos(30 * M_PI / 180), sz = std::sin(30 * M_PI / 180);
+  const double cx = std::cos(40 * M_PI / 180), sx = std::sin(40 * M_PI / 180);
+  {
+    std::ofstream off(dir / "box.off");
+    off.precision(17);
+    off << "OFF\n8 12 0\n";
+    for (int k = 0; k < 8; ++k) {
+      const double x = k & 1 ? 1.0 : 0.0, y0 = k & 2 ? 0.6 : 0.0, z0 = k & 4 ? 0.3 : 0.0;
+      const double y = cx * y0 - sx * z0, z = sx * y0 + cx * z0;  // about x, then about z
+      off << cz * x - sz * y << ' ' << sz * x + cz * y << ' ' << z << '\n';
+    }
+    for (const char* t : {"0 2 1", "1 2 3", "4 5 6", "5 7 6", "0 1 4", "1 5 4", "2 6 3", "3 6 7", "0 4 2", "2 4 6",
+                          "1 3 5", "3 7 5"})
+      off << "3 " << t << '\n';
+  }
+  const std::string common = "mesh3d '" + (dir / "box.off").string() + "' --level 3 --quiet --threads 1 -o '";
+  REQUIRE(run_status(common + (dir / "a").string() + "'") == 0);
+  REQUIRE(run_status(common + (dir / "b").string() + "' --given-axes") == 0);
+  const auto a = nlohmann::json::parse(read_text(dir / "a" / "report.json"));
+  const auto b = nlohmann::json::parse(read_text(dir / "b" / "report.json"));
+  CHECK(a["frame"]["turned"] == true);
+  CHECK(a["options"]["frame_turned"] == true);
+  CHECK(a["frame"]["planar_share_frame"].get<double>() == Approx(1.0));
+  CHECK(a["frame"]["planar_share_given"].get<double>() < 0.5);
+  // The axes: orthonormal rows.
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double dot = 0;
+      for (int k = 0; k < 3; ++k) dot += a["frame"]["axes"][i][k].get<double>() * a["frame"]["axes"][j][k].get<double>();
+      CHECK(dot == Approx(i == j ? 1.0 : 0.0).margin(1e-12));
+    }
+  CHECK(b["frame"]["turned"] == false);
+  CHECK(b["options"]["align_planar_faces"] == false);
+  CHECK(b["frame"]["planar_share_frame"].get<double>() == Approx(1.0));  // what the frame would have had
+  // In the frame the box's faces lie on lattice planes: a smaller volume error than in its axes.
+  CHECK(a["fidelity"]["volume_rel_error"].get<double>() < b["fidelity"]["volume_rel_error"].get<double>());
+  CHECK(a["validation"]["valid"] == true);
+  std::filesystem::remove_all(dir);
 }

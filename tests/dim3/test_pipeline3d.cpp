@@ -266,6 +266,7 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
   Options3d opt;
   opt.level = 3;
   opt.n_threads = 1;
+  opt.align_planar_faces = false;  // the regression's own axes (found in them)
   opt.max_repairs = 1;
   opt.raise_levels = 0;
   opt.thin_retry_cells = 0;
@@ -292,6 +293,7 @@ TEST_CASE("mesh3d tries without the buffer rule first, with facing projections n
   Options3d opt;
   opt.level = 3;
   opt.n_threads = 1;
+  opt.align_planar_faces = false;  // the regression's own axes (found in them)
   opt.thin_retry_cells = 0;
   REQUIRE(opt.buffer_last);
   REQUIRE(opt.buffer > 0);
@@ -339,6 +341,7 @@ TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused
   Options3d opt;
   opt.level = 3;
   opt.n_threads = 1;
+  opt.align_planar_faces = false;  // the regression's own axes (found in them)
   opt.thin_retry_cells = 0;
   opt.thickness_probe = false;
   Fallbacks f;
@@ -370,6 +373,7 @@ TEST_CASE("mesh3d's thickness probe stands where the first tree has problems at 
     Options3d opt;
     opt.level = 3;
     opt.n_threads = 1;
+    opt.align_planar_faces = false;  // the regression's own axes (found in them)
     opt.thickness_probe = probe;
     std::vector<std::string> lines;
     const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
@@ -407,6 +411,7 @@ TEST_CASE("mesh3d does not repeat a refused thickness probe's tree after a refus
     Options3d opt;
     opt.level = 3;
     opt.n_threads = 1;
+    opt.align_planar_faces = false;  // the regression's own axes (found in them)
     opt.effort = 2.0;
     opt.min_effort_octants = 0;
     opt.raise_levels = 0;
@@ -449,6 +454,7 @@ TEST_CASE("mesh3d skips the untangling rounds that would repeat one, with the sa
   Options3d opt;
   opt.level = 4;
   opt.n_threads = 1;
+  opt.align_planar_faces = false;  // the regression's own axes (found in them)
   opt.buffer_last = false;  // the skip happens in the buffer rule's try
   std::vector<std::string> lines[2];
   Result3d r[2];
