@@ -228,8 +228,10 @@ struct Options3d {
   /// planes square to an axis than the given axes do (dim3/planar_frame.hpp), and turn the mesh
   /// back: a machined part given at an angle is meshed as if given aligned. Surfaces without
   /// such faces (elephant, sphere966) and aligned parts are meshed in their own axes, unchanged.
-  /// When every try in the frame is refused, the run is made again in the given axes
-  /// (Result3d::frame_refused).
+  /// When every try in the frame is refused, or its mesh is one level finer than asked
+  /// (Result3d::level_raised) or leaves the thin parts out (thin_parts_coarse), the run is made
+  /// again in the given axes (Result3d::frame_refused); of two valid meshes, the one that loses
+  /// less of the volume stands (the frame's on a tie).
   bool align_planar_faces = true;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
@@ -273,7 +275,7 @@ struct Result3d {
   /// The frame meshed in (Options3d::align_planar_faces); with that option off, not turned, but
   /// share_frame says what the frame would have put on its planes.
   PlanarFrame frame;
-  bool frame_refused = false;        ///< every try in the frame was refused; this run is in the given axes
+  bool frame_refused = false;        ///< the frame's tries were refused at the level asked; this run is in the given axes
   std::vector<StageTime3> times;
   /// validate(fe.mesh, surface_validation(s)) where the pipeline made it of the mesh it returns
   /// (after the Escobar pass, with folds pending, the thickness retry), with content_hash of
