@@ -34,6 +34,17 @@ SurfaceBoundary boundary_of(const TriangleSoup& soup, const std::string& name) {
   return SurfaceBoundary(std::move(surface));
 }
 
+/// The options of a regression file's case: `level`, one thread, and the file's own axes: the
+/// regressions were found in them, and most are voxel unions at an angle, which mesh3d would
+/// mesh in the frame of their faces (Options3d::align_planar_faces).
+Options3d in_own_axes(int level) {
+  Options3d opt;
+  opt.level = level;
+  opt.n_threads = 1;
+  opt.align_planar_faces = false;
+  return opt;
+}
+
 }  // namespace
 
 TEST_CASE("sphere966 at level 4 gives a valid mesh close to the sphere's volume", "[pipeline3d]") {
@@ -263,10 +274,7 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
   if (test::sanitized()) return;  // 3 CPU s in Release (five tries of up to two trees)
   const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-hanging-node-concave-edge.off";
   SurfaceBoundary s = SurfaceBoundary::from_file(file);
-  Options3d opt;
-  opt.level = 3;
-  opt.n_threads = 1;
-  opt.align_planar_faces = false;  // the regression's own axes (found in them)
+  Options3d opt = in_own_axes(3);
   opt.max_repairs = 1;
   opt.raise_levels = 0;
   opt.thin_retry_cells = 0;
@@ -290,10 +298,7 @@ TEST_CASE("mesh3d with features_fallback_last drops feature snapping after every
 // first); on the voxel union with the hanging node all three tries with snapping are refused in
 // that order, and the mesh is the first try without snapping, without the buffer rule.
 TEST_CASE("mesh3d tries without the buffer rule first, with facing projections next, the buffer rule last", "[pipeline3d]") {
-  Options3d opt;
-  opt.level = 3;
-  opt.n_threads = 1;
-  opt.align_planar_faces = false;  // the regression's own axes (found in them)
+  Options3d opt = in_own_axes(3);
   opt.thin_retry_cells = 0;
   REQUIRE(opt.buffer_last);
   REQUIRE(opt.buffer > 0);
@@ -338,10 +343,7 @@ TEST_CASE("mesh3d's buffer rule try stands when the tries without it are refused
   if (test::sanitized()) return;  // about 3 CPU s in Release (three tries)
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) +
                                                  "/tests/dim3/regressions/voxel-seed4-case81-buffer-fallback.off");
-  Options3d opt;
-  opt.level = 3;
-  opt.n_threads = 1;
-  opt.align_planar_faces = false;  // the regression's own axes (found in them)
+  Options3d opt = in_own_axes(3);
   opt.thin_retry_cells = 0;
   opt.thickness_probe = false;
   Fallbacks f;
@@ -370,10 +372,7 @@ TEST_CASE("mesh3d's thickness probe stands where the first tree has problems at 
   double error[2] = {1.0, 1.0};
   for (const bool probe : probes) {
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
-    Options3d opt;
-    opt.level = 3;
-    opt.n_threads = 1;
-    opt.align_planar_faces = false;  // the regression's own axes (found in them)
+    Options3d opt = in_own_axes(3);
     opt.thickness_probe = probe;
     std::vector<std::string> lines;
     const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
@@ -408,10 +407,7 @@ TEST_CASE("mesh3d does not repeat a refused thickness probe's tree after a refus
       std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-hanging-node-concave-edge.off";
   for (const bool probe : {true, false}) {
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
-    Options3d opt;
-    opt.level = 3;
-    opt.n_threads = 1;
-    opt.align_planar_faces = false;  // the regression's own axes (found in them)
+    Options3d opt = in_own_axes(3);
     opt.effort = 2.0;
     opt.min_effort_octants = 0;
     opt.raise_levels = 0;
@@ -451,10 +447,7 @@ TEST_CASE("mesh3d does not repeat a refused thickness probe's tree after a refus
 TEST_CASE("mesh3d skips the untangling rounds that would repeat one, with the same mesh", "[pipeline3d]") {
   if (test::sanitized()) return;  // 2 x 2.3 CPU s in Release
   const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/voxel-island-trial.off";
-  Options3d opt;
-  opt.level = 4;
-  opt.n_threads = 1;
-  opt.align_planar_faces = false;  // the regression's own axes (found in them)
+  Options3d opt = in_own_axes(4);
   opt.buffer_last = false;  // the skip happens in the buffer rule's try
   std::vector<std::string> lines[2];
   Result3d r[2];

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -80,6 +81,40 @@ bool signed_permutation(const Eigen::Matrix3d& m, double tol) {
   }
   return true;
 }
+
+/// A union of voxels of the survey's generator (a 2 x 2 x 2 grid, `cells`, turned by `degrees`,
+/// shifted by `shift` tenths) meshed by mesh3d with the default options at level 3 on one thread,
+/// its progress lines kept.
+struct SurveyVoxels {
+  SurfaceBoundary s;
+  std::vector<std::string> lines;
+  Result3d r;
+  SurveyVoxels(const std::vector<int>& cells, const std::array<int, 3>& degrees, const std::array<int, 3>& shift)
+      : s(boundary(cells, degrees, shift)) {
+    Options3d opt;
+    opt.level = 3;
+    opt.n_threads = 1;
+    r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  }
+  /// How many progress lines contain `text`.
+  long said(const std::string& text) const {
+    return std::count_if(lines.begin(), lines.end(), [&](const std::string& m) { return m.find(text) != std::string::npos; });
+  }
+
+ private:
+  static SurfaceBoundary boundary(const std::vector<int>& cells, const std::array<int, 3>& degrees,
+                                  const std::array<int, 3>& shift) {
+    test::SurfaceSpec spec;
+    spec.kind = test::ShapeKind::Voxels;
+    spec.grid = 2;
+    spec.cells = cells;
+    spec.pose.degrees = degrees;
+    spec.pose.shift = shift;
+    Surface surface = test::to_surface(spec);
+    validate_surface(surface, "survey voxel union");
+    return SurfaceBoundary(std::move(surface));
+  }
+};
 
 }  // namespace
 
@@ -181,24 +216,13 @@ TEST_CASE("mesh3d meshes a part turned at an angle in the frame of its planar fa
 // that made things worse); at its angle it is valid.
 TEST_CASE("mesh3d meshes in the given axes where the frame's tries are refused", "[planar_frame][pipeline3d]") {
   if (test::sanitized()) return;  // 6.4 s in Release
-  test::SurfaceSpec spec;
-  spec.kind = test::ShapeKind::Voxels;
-  spec.grid = 2;
-  spec.cells = {0, 1, 2, 3, 4, 5};
-  spec.pose.degrees = {26, 66, 29};
-  spec.pose.shift = {4, -2, 0};
-  Surface surface = test::to_surface(spec);
-  validate_surface(surface, "survey voxel union");
-  SurfaceBoundary s(std::move(surface));
-  Options3d opt;
-  opt.level = 3;
-  opt.n_threads = 1;
-  std::vector<std::string> lines;
-  const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  const SurveyVoxels run({0, 1, 2, 3, 4, 5}, {26, 66, 29}, {4, -2, 0});
+  const Result3d& r = run.r;
+  const SurfaceBoundary& s = run.s;
   CHECK(r.frame_refused);
   CHECK_FALSE(r.frame.turned);
   CHECK(r.frame.share_frame > r.frame.share_given + 0.1);  // the frame would have had its faces
-  CHECK(std::count_if(lines.begin(), lines.end(), [](const std::string& m) {
+  CHECK(std::count_if(run.lines.begin(), run.lines.end(), [](const std::string& m) {
           return m.find("in the frame of the planar faces: refused (") == 0 &&
                  m.find("); once more in the given axes") != std::string::npos;
         }) == 1);
@@ -213,25 +237,11 @@ TEST_CASE("mesh3d meshes in the given axes where the frame's tries are refused",
 // 4, 0.17% lost; in the given axes 10,449 tets, 10.4% lost (its one-voxel parts): the frame's.
 TEST_CASE("mesh3d keeps the frame's finer mesh where it loses less than the given axes'", "[planar_frame][pipeline3d]") {
   if (test::sanitized()) return;  // 20 s in Release
-  test::SurfaceSpec spec;
-  spec.kind = test::ShapeKind::Voxels;
-  spec.grid = 2;
-  spec.cells = {0, 1, 2, 3, 4, 5, 6};
-  spec.pose.degrees = {22, 158, 153};
-  spec.pose.shift = {0, 1, -1};
-  Surface surface = test::to_surface(spec);
-  validate_surface(surface, "survey voxel union");
-  SurfaceBoundary s(std::move(surface));
-  Options3d opt;
-  opt.level = 3;
-  opt.n_threads = 1;
-  std::vector<std::string> lines;
-  const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
-  const auto said = [&](const std::string& text) {
-    return std::count_if(lines.begin(), lines.end(), [&](const std::string& m) { return m.find(text) != std::string::npos; });
-  };
-  CHECK(said("in the frame of the planar faces: refused (meshed only one level finer); once more in the given axes") == 1);
-  CHECK(said("the frame's mesh stands: 0.17% of the volume lost, 10.44% in the given axes") == 1);
+  const SurveyVoxels run({0, 1, 2, 3, 4, 5, 6}, {22, 158, 153}, {0, 1, -1});
+  const Result3d& r = run.r;
+  const SurfaceBoundary& s = run.s;
+  CHECK(run.said("in the frame of the planar faces: refused (meshed only one level finer); once more in the given axes") == 1);
+  CHECK(run.said("the frame's mesh stands: 0.17% of the volume lost, 10.44% in the given axes") == 1);
   CHECK(r.frame.turned);
   CHECK_FALSE(r.frame_refused);
   CHECK(r.level_raised == 1);
