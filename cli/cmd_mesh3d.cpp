@@ -52,6 +52,10 @@ const char* help_text =
     "  --given-axes        mesh in the input's axes (by default a part whose flat faces lie\n"
     "                      at an angle to them is meshed in the frame of those faces and\n"
     "                      turned back: report.json \"frame\")\n"
+    "  --lattice-draws N   where the mesh is degraded (refused, one level finer, thin parts\n"
+    "                      left out, a dihedral angle under 10 deg), mesh again up to N\n"
+    "                      times with the octree's lattice shifted against the part, within\n"
+    "                      the work bound left (0..2, default 2; report.json lattice_draw)\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -101,7 +105,8 @@ int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
-                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort"});
+                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
+                   "--lattice-draws"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -123,6 +128,7 @@ int run(const std::vector<std::string>& argv) {
   opt.thickness_probe = !args.has("--no-thickness-probe");
   opt.align_planar_faces = !args.has("--given-axes");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
+  opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
@@ -202,7 +208,14 @@ int run(const std::vector<std::string>& argv) {
                     {"level_raised", r.level_raised},
                     {"align_planar_faces", opt.align_planar_faces},
                     {"frame_turned", r.frame.turned},
-                    {"frame_refused", r.frame_refused}};
+                    {"frame_refused", r.frame_refused},
+                    {"lattice_draws", opt.lattice_draws},
+                    {"lattice_draws_run", r.lattice_draws_run},
+                    {"lattice_draw", r.lattice_draw}};
+  {
+    const dim3::P3 shift = dim3::lattice_draw_shift(r.lattice_draw);
+    rep["options"]["lattice_shift"] = {shift.x(), shift.y(), shift.z()};
+  }
   // The frame meshed in (Options3d::align_planar_faces): its axes as rows, in the input's
   // coordinates, and the share of the area on planes square to them and to the given axes.
   nlohmann::json axes = nlohmann::json::array();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -302,15 +303,18 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
 
 namespace {
 
-/// mesh3d in the surface's own axes: the tries, the fallbacks after a refusal, the thin retry.
-Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
-  Effort effort;
+/// mesh3d in the surface's own axes: the tries, the fallbacks after a refusal (unless
+/// `draw`: a lattice draw's refusal is its end), the thin retry. `effort` may come with a limit.
+Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort, bool draw,
+                        const Progress3& progress) {
   Result3d r;
   try {
     r = mesh3d_raised(s, opt, effort, progress);
   } catch (const GeometryError& e) {
+    if (draw) throw;
     return after_refusal(s, opt, effort, e, progress);
   } catch (const LimitError& e) {
+    if (draw) throw;
     return after_refusal(s, opt, effort, e, progress);
   }
   r.n_octants_built = effort.used;
@@ -370,81 +374,162 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, const Progress
   return r;
 }
 
+/// One run of mesh3d_in_axes on a lattice, and what the draws rank it by.
+struct Drawn {
+  std::optional<Result3d> r;  ///< empty: refused
+  std::string why;            ///< the refusal's reason
+  bool limit_error = false;   ///< refused by a bound (LimitError), not by the geometry
+  Effort effort;
+  int rank = 3;  ///< 0 not degraded, 1 degraded, 2 not valid, 3 refused
+  double error = std::numeric_limits<double>::infinity();  ///< volume error
+  std::string degraded;                                   ///< how, for the progress report
+};
+
+/// mesh3d_in_axes on `s` with its root cube shifted by lattice_draw_shift(k), within `limit`
+/// octants (0: the work bound of the run's first tree), ranked on `s` as meshed.
+Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, const Progress3& progress) {
+  Drawn d;
+  d.effort.limit = limit;
+  const P3 shift0 = s.root_shift();
+  s.set_root_shift(shift0 + lattice_draw_shift(k));
+  Options3d o = opt;
+  if (k > 0) o.raise_levels = 0;  // a level raise is degraded anyway
+  try {
+    Result3d r = mesh3d_in_axes(s, o, d.effort, k > 0, progress);
+    const ValidationReport& v = validation_of(r, s, opt.n_threads);
+    d.error = volume_error(r.fe.mesh, s, opt.n_threads);
+    const double min_deg = summarize_quality(r.fe.mesh, 10.0, opt.n_threads).min_angle_deg;
+    if (r.level_raised > 0) d.degraded = "one level finer than asked";
+    else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
+    else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
+    else if (min_deg < opt.draw_min_dihedral_deg) d.degraded = "a dihedral angle of " + std::to_string(min_deg) + " deg";
+    d.rank = !v.valid ? 2 : d.degraded.empty() ? 0 : 1;
+    if (!v.valid) d.degraded = "not valid (" + v.summary() + ")";
+    r.lattice_draw = k;
+    d.r = std::move(r);
+  } catch (const GeometryError& e) {
+    d.why = e.what();
+  } catch (const LimitError& e) {
+    d.why = e.what();
+    d.limit_error = true;
+  }
+  s.set_root_shift(shift0);
+  return d;
+}
+
+/// What is left of a draw's work bound for the next one (0 when nothing is: no draw).
+std::size_t left_of(const Effort& e) { return e.limit > e.used ? e.limit - e.used : 0; }
+
 }  // namespace
+
+P3 lattice_draw_shift(int k) {
+  // Shares of the root cube's side: a hundredth or so, not a ratio of small integers, so that
+  // no lattice plane of levels up to 9 comes back where it was. Measured (level 5, fandisk
+  // turned by two random rotations and by 180 degrees about x; session 34): the first shift
+  // made the two turned ones valid in their frame at 19.00 and 20.29 deg (refused there
+  // without it), the second the 180-degree one at 15.29 deg (thin parts left out without it,
+  // 5.98 deg with the first shift).
+  if (k == 1) return P3(0.011, 0.007, 0.013);
+  if (k == 2) return P3(-0.009, 0.015, -0.012);
+  return P3::Zero();
+}
 
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
   PlanarFrame frame = planar_frame(s.surface());
-  const auto in_given_axes = [&] {
-    Result3d r = mesh3d_in_axes(s, opt, progress);
-    r.frame = frame;
-    r.frame.turned = false;  // share_frame still says what the frame would have had
-    r.frame.to_frame = Eigen::Matrix3d::Identity();
-    return r;
+  const bool turn = opt.align_planar_faces && frame.turned;
+  std::optional<SurfaceBoundary> turned;
+  if (turn) {
+    if (progress) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "planar faces: %.0f%% of the area on planes square to the frame's axes, %.0f%% to the given ones: "
+                    "meshing in that frame",
+                    100 * frame.share_frame, 100 * frame.share_given);
+      progress(text);
+    }
+    turned.emplace(turned_surface(s.surface(), frame.to_frame), s.options());
+  }
+  // The runs in order: (in the frame?, draw). Each stands when it is not degraded; the draws
+  // of one axes share its work bound.
+  struct Plan {
+    bool in_frame;
+    int draw;
   };
-  if (!(opt.align_planar_faces && frame.turned)) return in_given_axes();
-  if (progress) {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "planar faces: %.0f%% of the area on planes square to the frame's axes, %.0f%% to the given ones: "
-                  "meshing in that frame",
-                  100 * frame.share_frame, 100 * frame.share_given);
-    progress(text);
+  std::vector<Plan> plan{{turn, 0}};
+  for (int k = 1; k <= opt.lattice_draws; ++k) plan.push_back({turn, k});
+  if (turn) {
+    // The frame's draws but the first, then the given axes: flat faces a little off the
+    // lattice planes make flat boundary octants, which a face at an angle does not. Measured,
+    // 13 of 400 voxel unions of the survey (seeds 4 and 5, level 3) were refused in their frame
+    // and none in their given axes (session 33, one lattice).
+    plan.resize(std::min<std::size_t>(plan.size(), 2));
+    plan.push_back({false, 0});
   }
-  std::string why;
-  std::optional<Result3d> framed;
-  try {
-    SurfaceBoundary turned(turned_surface(s.surface(), frame.to_frame), s.options());
-    Result3d r = mesh3d_in_axes(turned, opt, progress);
-    // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to rounding).
-    const Eigen::Matrix3d back = frame.to_frame.transpose();
-    for (P3& p : r.fe.mesh.points) p = back * p;
-    // The pipeline's report was of the turned mesh against the turned surface.
-    r.validation.reset();
-    r.validation_hash = 0;
-    r.frame = frame;
-    // Every try at the level asked was refused, and the mesh is one level finer or leaves the
-    // thin parts out: the given axes may do without either, and lose less.
-    if (!(r.level_raised > 0 || r.thin_parts_coarse)) return r;
-    why = r.level_raised > 0 ? "meshed only one level finer" : "the thin parts left out";
-    framed = std::move(r);
-  } catch (const GeometryError& e) {
-    why = e.what();
-  } catch (const LimitError& e) {
-    why = e.what();
-  }
-  // Flat faces a little off the lattice planes make flat boundary octants, which a face at an
-  // angle does not: measured, 13 of 400 voxel unions of the survey (seeds 4 and 5, level 3)
-  // were refused in their frame and none in their given axes; 7 more were meshed there one
-  // level finer (6) or without a thin part (1), and in the given axes at the level asked (the
-  // 6 losing more of the volume than the frame's finer meshes, the one less).
-  if (progress) progress("in the frame of the planar faces: refused (" + why + "); once more in the given axes");
-  try {
-    Result3d r = in_given_axes();
-    if (framed) {
-      // Both valid: the one that loses less of the solid (the frame's on a tie). Measured (voxel
-      // survey seed 4, case 179, level 3): in the frame one level finer, 232,153 tets, 0.17%
-      // lost; in the given axes 10,449 tets, 10.4% lost: the frame's stands.
-      const double in_frame = volume_error(framed->fe.mesh, s, opt.n_threads);
-      const double given = volume_error(r.fe.mesh, s, opt.n_threads);
-      if (!(given < in_frame)) {
-        if (progress) {
-          char text[160];
-          std::snprintf(text, sizeof text, "the frame's mesh stands: %.2f%% of the volume lost, %.2f%% in the given axes",
-                        100 * in_frame, 100 * given);
-          progress(text);
-        }
-        return std::move(*framed);
+  std::vector<Drawn> runs;
+  std::size_t best = 0;
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    const Plan& p = plan[i];
+    SurfaceBoundary& on = p.in_frame ? *turned : s;
+    std::size_t limit = 0;
+    if (p.draw > 0) {
+      limit = left_of(runs.back().effort);
+      if (limit == 0) {
+        if (progress) progress("lattice draw " + std::to_string(p.draw) + ": no work bound left; not made");
+        continue;
       }
     }
-    r.frame_refused = true;
-    return r;
-  } catch (const GeometryError& e) {
-    if (framed) return std::move(*framed);
-    throw GeometryError("in the frame of the planar faces: " + why + "; in the given axes: " + e.what());
-  } catch (const LimitError& e) {
-    if (framed) return std::move(*framed);
-    throw LimitError("in the frame of the planar faces: " + why + "; in the given axes: " + e.what());
+    if (i > 0 && progress) {
+      const Drawn& last = runs.back();
+      const std::string what = last.r ? last.degraded : "refused (" + last.why + ")";
+      const P3 shift = lattice_draw_shift(p.draw);
+      char by[96];
+      std::snprintf(by, sizeof by, "(%g, %g, %g)", shift.x(), shift.y(), shift.z());
+      if (p.draw > 0)
+        progress(what + ": once more with the lattice shifted by " + by + " of the root's side" +
+                 (p.in_frame ? ", in the frame" : ""));
+      else
+        progress("in the frame of the planar faces: " + what + "; once more in the given axes");
+    }
+    runs.push_back(run_drawn(on, opt, p.draw, limit, progress));
+    Drawn& d = runs.back();
+    if (d.r) {
+      d.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
+      d.r->frame = frame;
+      if (p.in_frame) {
+        // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to
+        // rounding); the report was of the turned mesh against the turned surface.
+        const Eigen::Matrix3d back = frame.to_frame.transpose();
+        for (P3& q : d.r->fe.mesh.points) q = back * q;
+        d.r->validation.reset();
+        d.r->validation_hash = 0;
+      } else {
+        d.r->frame.turned = false;  // share_frame still says what the frame would have had
+        d.r->frame.to_frame = Eigen::Matrix3d::Identity();
+        d.r->frame_refused = turn;
+      }
+    }
+    // Of the runs so far: the lowest rank, then the least volume lost, then the first.
+    if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
+    if (d.rank == 0) break;
   }
+  Drawn& b = runs[best];
+  if (!b.r) {
+    // Every run refused: the first run's refusal (the same type), with the others' reasons.
+    std::string reasons = runs[0].why;
+    for (std::size_t i = 1; i < runs.size(); ++i)
+      reasons += std::string("; ") + (plan[i].draw > 0 ? "lattice draw " + std::to_string(plan[i].draw) : "in the given axes") +
+                 ": " + runs[i].why;
+    if (turn) reasons = "in the frame of the planar faces: " + reasons;
+    if (runs[0].limit_error) throw LimitError(reasons);
+    throw GeometryError(reasons);
+  }
+  if (runs.size() > 1 && progress) {
+    char lost[64];
+    std::snprintf(lost, sizeof lost, "%.2f%% of the volume lost", 100 * b.error);
+    progress("of " + std::to_string(runs.size()) + " runs, run " + std::to_string(best + 1) + " stands (" +
+             (b.degraded.empty() ? std::string("not degraded") : b.degraded) + ", " + lost + ")");
+  }
+  return std::move(*b.r);
 }
 
 }  // namespace febemesh::dim3

@@ -228,11 +228,26 @@ struct Options3d {
   /// planes square to an axis than the given axes do (dim3/planar_frame.hpp), and turn the mesh
   /// back: a machined part given at an angle is meshed as if given aligned. Surfaces without
   /// such faces (elephant, sphere966) and aligned parts are meshed in their own axes, unchanged.
-  /// When every try in the frame is refused, or its mesh is one level finer than asked
-  /// (Result3d::level_raised) or leaves the thin parts out (thin_parts_coarse), the run is made
-  /// again in the given axes (Result3d::frame_refused); of two valid meshes, the one that loses
-  /// less of the volume stands (the frame's on a tie).
+  /// When the frame's mesh is degraded (lattice_draws below), the frame gets one lattice draw,
+  /// then the run is made in the given axes (Result3d::frame_refused), and the mesh ranked first
+  /// there stands.
   bool align_planar_faces = true;
+  /// Lattice draws: where the mesh is degraded (refused; one level finer than asked; the thin
+  /// parts left out; the buffer rule's try; a dihedral angle under draw_min_dihedral_deg) the
+  /// run is made again, up to this many times, with the root cube shifted against the surface
+  /// (lattice_draw_shift), and the first mesh that is not degraded stands; when none is, the
+  /// valid one that loses the least volume (Result3d::lattice_draw). A mesh at the level asked
+  /// that loses more volume than a degraded one still stands over it (its parts thinner than
+  /// the octants are a matter of the level). Which tries fail depends on
+  /// where the lattice planes cut the part (fandisk turned 180 degrees about x, the same
+  /// lattice turned with it, is meshed only with its thin parts left out at level 5; shifted by
+  /// a hundredth of the root's side, at 15 degrees). A draw runs the tries at the level asked
+  /// within what the runs before it left of the work bound (Options3d::effort), without the
+  /// fallbacks after a refusal. For a part meshed in the frame of its planar faces, the second
+  /// run is the frame's draw, the third the given axes (with a work bound of their own). 0:
+  /// one lattice (as before session 34).
+  int lattice_draws = 2;
+  double draw_min_dihedral_deg = 10.0;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;
@@ -276,6 +291,10 @@ struct Result3d {
   /// share_frame says what the frame would have put on its planes.
   PlanarFrame frame;
   bool frame_refused = false;        ///< the frame's tries were refused at the level asked; this run is in the given axes
+  /// Options3d::lattice_draws: 0 = the first lattice; k = the lattice shifted by
+  /// lattice_draw_shift(k) (the root cube's side times it).
+  int lattice_draw = 0;
+  int lattice_draws_run = 0;         ///< draws made after the first lattice's run
   std::vector<StageTime3> times;
   /// validate(fe.mesh, surface_validation(s)) where the pipeline made it of the mesh it returns
   /// (after the Escobar pass, with folds pending, the thickness retry), with content_hash of
@@ -295,6 +314,10 @@ using Progress3 = std::function<void(const std::string&)>;
 /// then all without (Options3d::features_fallback_last, Result3d::features_dropped); when those
 /// are refused cheaply, all of it one level finer (Options3d::raise_levels).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
+
+/// The root cube's shift of lattice draw k (1, 2; Options3d::lattice_draws), in shares of its
+/// side (SurfaceOptions::root_shift); zero for k = 0.
+P3 lattice_draw_shift(int k);
 
 /// The buffer rules of opt on the interior octants `in`: Options3d::buffer, then flat_buffer
 /// where it reaches farther (apply_buffer's whole faces). Returns how many octants they dropped.

@@ -51,6 +51,8 @@ notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_sna
          if r["options"].get(k)]
 if r["options"].get("level_raised"):
     notes.append(f"level_raised {r['options']['level_raised']}")
+if r["options"].get("lattice_draws_run"):
+    notes.append(f"lattice_draw {r['options']['lattice_draw']} ({r['options']['lattice_draws_run'] + 1} runs)")
 status = "valid" if v["valid"] else "invalid"
 print(f"| {s} | {level} | {kind} | {status} | {q['n_elements']} | {c['tetrahedra']} | {q['min_dihedral_deg']:.2f} | "
       f"{100 * f['volume_rel_error']:.2f}% | {f['hausdorff_rel']:.2e} | {cpu:.1f} | {mb:.0f} | {', '.join(notes)} |")

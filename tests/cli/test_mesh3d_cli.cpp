@@ -137,6 +137,27 @@ TEST_CASE("mesh3d --no-thickness-probe: the report says whether the probe ran an
   CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));
 }
 
+TEST_CASE("mesh3d --lattice-draws: the report names the draws; a mesh that is not degraded draws none", "[cli][mesh3d]") {
+  // sphere966 at level 3: its first lattice's mesh is valid at the level asked and above 10
+  // degrees, so no draw is made (Options3d::lattice_draws) and both meshes are the same. Where
+  // draws stand: tests/dim3/test_planar_frame.cpp and the level-raise regression.
+  const SpherePair runs("draws", 3, "--lattice-draws 0");
+  const auto drawn = runs.report("a"), one = runs.report("b");
+  CHECK(drawn["options"]["lattice_draws"] == 2);
+  CHECK(one["options"]["lattice_draws"] == 0);
+  for (const auto& r : {drawn, one}) {
+    CHECK(r["options"]["lattice_draws_run"] == 0);
+    CHECK(r["options"]["lattice_draw"] == 0);
+    CHECK(r["options"]["lattice_shift"] == nlohmann::json::array({0.0, 0.0, 0.0}));
+  }
+  CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));
+  // Out of range: bad usage (status 2), nothing written.
+  const auto out = runs.dir / "c";
+  CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --lattice-draws 3 -o '" +
+                   out.string() + "'") == 2);
+  CHECK_FALSE(std::filesystem::exists(out));
+}
+
 TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in its own", "[cli][mesh3d]") {
   // A box 1 x 0.6 x 0.3 turned by 30 degrees about z and 40 about x: every face at an angle to
   // the given axes (Options3d::align_planar_faces, dim3/planar_frame.hpp).

@@ -34,14 +34,16 @@ SurfaceBoundary boundary_of(const TriangleSoup& soup, const std::string& name) {
   return SurfaceBoundary(std::move(surface));
 }
 
-/// The options of a regression file's case: `level`, one thread, and the file's own axes: the
-/// regressions were found in them, and most are voxel unions at an angle, which mesh3d would
-/// mesh in the frame of their faces (Options3d::align_planar_faces).
+/// The options of a regression file's case: `level`, one thread, the file's own axes and one
+/// lattice: the regressions were found in them, and most are voxel unions at an angle, which
+/// mesh3d would mesh in the frame of their faces (Options3d::align_planar_faces); these tests
+/// are of the tries on one lattice, not of the lattice draws (Options3d::lattice_draws).
 Options3d in_own_axes(int level) {
   Options3d opt;
   opt.level = level;
   opt.n_threads = 1;
   opt.align_planar_faces = false;
+  opt.lattice_draws = 0;
   return opt;
 }
 

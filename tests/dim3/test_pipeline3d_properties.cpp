@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/quality.hpp"
 #include "core/read_msh.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
@@ -59,12 +60,13 @@ double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 
 /// Meshes `surface` (validated and oriented here, as the CLI does) at `level` and measures it;
 /// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off).
-Outcome3 run_surface(Surface surface, int level, bool given_axes = false) {
+Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
   opt.level = level;
   opt.align_planar_faces = !given_axes;
+  opt.lattice_draws = lattice_draws;
   Outcome3 out{mesh3d(s, opt), {}};
   const Mesh<3>& m = out.r.fe.mesh;
   const Box<3> bb = s.bounding_box();
@@ -297,7 +299,9 @@ std::string fallbacks_of(const Result3d& r) {
                                                 {r.thin_parts_coarse, "thin_parts_coarse"},
                                                 {r.level_raised > 0, "level_raised"},
                                                 {r.frame.turned, "planar_frame"},
-                                                {r.frame_refused, "frame_refused"}};
+                                                {r.frame_refused, "frame_refused"},
+                                                {r.lattice_draw > 0, "lattice_draw"},
+                                                {r.lattice_draws_run > 0, "lattice_draws_run"}};
   for (const auto& [set, name] : flags)
     if (set) out += (out.empty() ? "" : ",") + std::string(name);
   return out;
@@ -306,8 +310,9 @@ std::string fallbacks_of(const Result3d& r) {
 }  // namespace
 
 // FEBEMESH_SURVEY=sphere1|torus|voxel FEBEMESH_SURVEY_CASES=N [FEBEMESH_SURVEY_DIR=DIR]
-// [FEBEMESH_SURVEY_KEEP=FLAG] [FEBEMESH_SURVEY_GIVEN_AXES=1] [RC_PARAMS="seed=S"] test_dim3
-// "[.survey]" (GIVEN_AXES: Options3d::align_planar_faces off): runs N generated cases
+// [FEBEMESH_SURVEY_KEEP=FLAG] [FEBEMESH_SURVEY_GIVEN_AXES=1] [FEBEMESH_SURVEY_LATTICE_DRAWS=N]
+// [RC_PARAMS="seed=S"] test_dim3 "[.survey]" (GIVEN_AXES: Options3d::align_planar_faces off;
+// LATTICE_DRAWS: Options3d::lattice_draws, 0 for one lattice): runs N generated cases
 // of the family (the same generators and sizes as the properties above), prints every case with
 // the fallbacks that made its mesh, every refused or invalid one with why and, with
 // FEBEMESH_SURVEY_DIR, writes those there as OFF files (unshrunk), and the valid ones whose
@@ -324,6 +329,8 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
   const char* dir = std::getenv("FEBEMESH_SURVEY_DIR");
   const char* keep = std::getenv("FEBEMESH_SURVEY_KEEP");
   const bool given_axes = std::getenv("FEBEMESH_SURVEY_GIVEN_AXES") != nullptr;
+  const char* draws_env = std::getenv("FEBEMESH_SURVEY_LATTICE_DRAWS");
+  const int lattice_draws = draws_env ? std::atoi(draws_env) : Options3d{}.lattice_draws;
   rc::detail::TestParams params = rc::detail::configuration().testParams;
   params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
   params.disableShrinking = true;
@@ -338,7 +345,7 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
         std::string why, how;
         const auto t0 = std::chrono::steady_clock::now();
         try {
-          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes);
+          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws);
           ++tally.cases;
           how = fallbacks_of(out.r);
           if (!out.v.valid) why = "INVALID: " + out.v.summary();
@@ -475,10 +482,21 @@ TEST_CASE("a cheap refusal at a coarse level is meshed one level finer", "[pipel
   const fs::path file = fs::path(FEBEMESH_SOURCE_DIR) / "tests" / "dim3" / "regressions" / "voxel-seed5-case180-level-raised.off";
   REQUIRE(file_level(file) == 3);
   std::ifstream in(file);
-  const Outcome3 out = run_surface(Surface(read_off(in, file.string())), 3, true);  // its axes
+  const Surface surface(read_off(in, file.string()));
+  const Outcome3 out = run_surface(surface, 3, true, 0);  // its axes, one lattice
   INFO(out.v.summary());
   CHECK(out.v.valid);
   CHECK(out.r.level_raised == 1);
+  CHECK(out.r.lattice_draws_run == 0);
+  // With the lattice draws (Options3d::lattice_draws) the raised mesh is degraded: the lattice
+  // is shifted, and a draw at level 3 stands.
+  const Outcome3 drawn = run_surface(surface, 3, true);
+  INFO(drawn.v.summary());
+  CHECK(drawn.v.valid);
+  CHECK(drawn.r.level_raised == 0);
+  CHECK(drawn.r.lattice_draw > 0);
+  CHECK(drawn.r.lattice_draws_run == drawn.r.lattice_draw);
+  CHECK(summarize_quality<3>(drawn.r.fe.mesh).min_angle_deg >= Options3d{}.draw_min_dihedral_deg);
 }
 
 TEST_CASE("shrunk 3D property counterexamples not fixed yet", "[pipeline3d][regression][!mayfail]") {
