@@ -56,6 +56,8 @@ const char* help_text =
     "                      left out, a dihedral angle under 10 deg), mesh again up to N\n"
     "                      times with the octree's lattice shifted against the part, within\n"
     "                      the work bound left (0..2, default 2; report.json lattice_draw)\n"
+    "  --draw-below DEG    the dihedral angle under which a mesh counts as degraded for\n"
+    "                      the lattice draws (0..30, default 10)\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -106,7 +108,7 @@ int run(const std::vector<std::string>& argv) {
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
-                   "--lattice-draws"});
+                   "--lattice-draws", "--draw-below"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -129,6 +131,7 @@ int run(const std::vector<std::string>& argv) {
   opt.align_planar_faces = !args.has("--given-axes");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);
+  opt.draw_min_dihedral_deg = args.real_or("--draw-below", opt.draw_min_dihedral_deg, 0.0, 30.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
@@ -210,6 +213,7 @@ int run(const std::vector<std::string>& argv) {
                     {"frame_turned", r.frame.turned},
                     {"frame_refused", r.frame_refused},
                     {"lattice_draws", opt.lattice_draws},
+                    {"draw_below_deg", opt.draw_min_dihedral_deg},
                     {"lattice_draws_run", r.lattice_draws_run},
                     {"lattice_draw", r.lattice_draw}};
   {

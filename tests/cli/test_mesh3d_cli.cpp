@@ -145,6 +145,7 @@ TEST_CASE("mesh3d --lattice-draws: the report names the draws; a mesh that is no
   const auto drawn = runs.report("a"), one = runs.report("b");
   CHECK(drawn["options"]["lattice_draws"] == 2);
   CHECK(one["options"]["lattice_draws"] == 0);
+  CHECK(drawn["options"]["draw_below_deg"].get<double>() == 10.0);  // Options3d::draw_min_dihedral_deg
   for (const auto& r : {drawn, one}) {
     CHECK(r["options"]["lattice_draws_run"] == 0);
     CHECK(r["options"]["lattice_draw"] == 0);
@@ -154,6 +155,8 @@ TEST_CASE("mesh3d --lattice-draws: the report names the draws; a mesh that is no
   // Out of range: bad usage (status 2), nothing written.
   const auto out = runs.dir / "c";
   CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --lattice-draws 3 -o '" +
+                   out.string() + "'") == 2);
+  CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --draw-below 31 -o '" +
                    out.string() + "'") == 2);
   CHECK_FALSE(std::filesystem::exists(out));
 }

@@ -60,13 +60,15 @@ double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 
 /// Meshes `surface` (validated and oriented here, as the CLI does) at `level` and measures it;
 /// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off).
-Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws) {
+Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws,
+                     double draw_below = Options3d{}.draw_min_dihedral_deg) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
   opt.level = level;
   opt.align_planar_faces = !given_axes;
   opt.lattice_draws = lattice_draws;
+  opt.draw_min_dihedral_deg = draw_below;
   Outcome3 out{mesh3d(s, opt), {}};
   const Mesh<3>& m = out.r.fe.mesh;
   const Box<3> bb = s.bounding_box();
@@ -312,7 +314,8 @@ std::string fallbacks_of(const Result3d& r) {
 // FEBEMESH_SURVEY=sphere1|torus|voxel FEBEMESH_SURVEY_CASES=N [FEBEMESH_SURVEY_DIR=DIR]
 // [FEBEMESH_SURVEY_KEEP=FLAG] [FEBEMESH_SURVEY_GIVEN_AXES=1] [FEBEMESH_SURVEY_LATTICE_DRAWS=N]
 // [RC_PARAMS="seed=S"] test_dim3 "[.survey]" (GIVEN_AXES: Options3d::align_planar_faces off;
-// LATTICE_DRAWS: Options3d::lattice_draws, 0 for one lattice): runs N generated cases
+// LATTICE_DRAWS: Options3d::lattice_draws, 0 for one lattice; FEBEMESH_SURVEY_DRAW_BELOW=DEG:
+// Options3d::draw_min_dihedral_deg): runs N generated cases
 // of the family (the same generators and sizes as the properties above), prints every case with
 // the fallbacks that made its mesh, every refused or invalid one with why and, with
 // FEBEMESH_SURVEY_DIR, writes those there as OFF files (unshrunk), and the valid ones whose
@@ -331,6 +334,8 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
   const bool given_axes = std::getenv("FEBEMESH_SURVEY_GIVEN_AXES") != nullptr;
   const char* draws_env = std::getenv("FEBEMESH_SURVEY_LATTICE_DRAWS");
   const int lattice_draws = draws_env ? std::atoi(draws_env) : Options3d{}.lattice_draws;
+  const char* below_env = std::getenv("FEBEMESH_SURVEY_DRAW_BELOW");
+  const double draw_below = below_env ? std::atof(below_env) : Options3d{}.draw_min_dihedral_deg;
   rc::detail::TestParams params = rc::detail::configuration().testParams;
   params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
   params.disableShrinking = true;
@@ -345,7 +350,7 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
         std::string why, how;
         const auto t0 = std::chrono::steady_clock::now();
         try {
-          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws);
+          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws, draw_below);
           ++tally.cases;
           how = fallbacks_of(out.r);
           if (!out.v.valid) why = "INVALID: " + out.v.summary();
