@@ -383,12 +383,14 @@ struct Drawn {
   int rank = 3;  ///< 0 not degraded, 1 degraded, 2 not valid, 3 refused
   double error = std::numeric_limits<double>::infinity();  ///< volume error
   std::string degraded;                                   ///< how, for the progress report
+  int draw = 0;                                           ///< lattice_draw_shift(draw)
 };
 
 /// mesh3d_in_axes on `s` with its root cube shifted by lattice_draw_shift(k), within `limit`
 /// octants (0: the work bound of the run's first tree), ranked on `s` as meshed.
 Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, const Progress3& progress) {
   Drawn d;
+  d.draw = k;
   d.effort.limit = limit;
   const P3 shift0 = s.root_shift();
   s.set_root_shift(shift0 + lattice_draw_shift(k));
@@ -517,7 +519,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     // Every run refused: the first run's refusal (the same type), with the others' reasons.
     std::string reasons = runs[0].why;
     for (std::size_t i = 1; i < runs.size(); ++i)
-      reasons += std::string("; ") + (plan[i].draw > 0 ? "lattice draw " + std::to_string(plan[i].draw) : "in the given axes") +
+      reasons += std::string("; ") + (runs[i].draw > 0 ? "lattice draw " + std::to_string(runs[i].draw) : "in the given axes") +
                  ": " + runs[i].why;
     if (turn) reasons = "in the frame of the planar faces: " + reasons;
     if (runs[0].limit_error) throw LimitError(reasons);

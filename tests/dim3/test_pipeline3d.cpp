@@ -661,3 +661,31 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   CHECK(moved_on > 0);
   CHECK(on < off);
 }
+
+// A run refused before it built a tree (the octants over Options3d::max_cells) has no work bound
+// for a lattice draw: none is made, and the refusal is the first lattice's, of the same type.
+TEST_CASE("mesh3d's lattice draws keep a refusal before any tree as it was", "[pipeline3d]") {
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
+  Options3d opt;
+  opt.level = 4;
+  opt.max_cells = 1000;
+  std::vector<std::string> lines;
+  std::string one, drawn;
+  try {
+    Options3d single = opt;
+    single.lattice_draws = 0;
+    mesh3d(s, single);
+  } catch (const LimitError& e) {
+    one = e.what();
+  }
+  try {
+    mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  } catch (const LimitError& e) {
+    drawn = e.what();
+  }
+  CHECK_FALSE(one.empty());
+  CHECK(drawn == one);
+  CHECK(std::count(lines.begin(), lines.end(), "lattice draw 1: no work bound left; not made") == 1);
+  CHECK(std::count(lines.begin(), lines.end(), "lattice draw 2: no work bound left; not made") == 1);
+  CHECK(s.root_shift() == P3::Zero());
+}
