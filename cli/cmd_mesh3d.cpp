@@ -177,9 +177,11 @@ int run(const std::vector<std::string>& argv) {
   // The pipeline's report of this mesh with these checks, when it made one (meshes from the
   // Escobar pass, with folds, from the thickness retry) and the mesh is still that one (its
   // content hash): the same report without validating twice (elephant L4: 1.4 s a thread).
-  const bool reported = r.validation && r.validation_hash == content_hash(mesh);
+  const std::uint64_t hash = content_hash(mesh);
+  const bool reported = r.validation && r.validation_hash == hash;
   const ValidationReport vr = reported ? *r.validation : validate(mesh, vo);
-  const QualitySummary q = summarize_quality(mesh, 10.0, opt.n_threads);
+  // Likewise the quality summary mesh3d took to rank the lattice draws.
+  const QualitySummary q = r.quality && r.quality_hash == hash ? *r.quality : summarize_quality(mesh, 10.0, opt.n_threads);
   const dim3::Fidelity3d fid = measuring.get();
   const double t_check = std::chrono::duration<double>(std::chrono::steady_clock::now() - tv).count();
 

@@ -400,7 +400,9 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
     Result3d r = mesh3d_in_axes(s, o, d.effort, k > 0, progress);
     const ValidationReport& v = validation_of(r, s, opt.n_threads);
     d.error = volume_error(r.fe.mesh, s, opt.n_threads);
-    const double min_deg = summarize_quality(r.fe.mesh, 10.0, opt.n_threads).min_angle_deg;
+    r.quality = summarize_quality(r.fe.mesh, 10.0, opt.n_threads);
+    r.quality_hash = r.validation_hash;  // validation_of's hash of this mesh
+    const double min_deg = r.quality->min_angle_deg;
     if (r.level_raised > 0) d.degraded = "one level finer than asked";
     else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
     else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
@@ -504,6 +506,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
         for (P3& q : d.r->fe.mesh.points) q = back * q;
         d.r->validation.reset();
         d.r->validation_hash = 0;
+        d.r->quality.reset();
+        d.r->quality_hash = 0;
       } else {
         d.r->frame.turned = false;  // share_frame still says what the frame would have had
         d.r->frame.to_frame = Eigen::Matrix3d::Identity();
