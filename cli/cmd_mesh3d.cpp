@@ -53,7 +53,7 @@ const char* help_text =
     "                      at an angle to them is meshed in the frame of those faces and\n"
     "                      turned back: report.json \"frame\")\n"
     "  --lattice-draws N   where the mesh is degraded (refused, one level finer, thin parts\n"
-    "                      left out, a dihedral angle under 10 deg), mesh again up to N\n"
+    "                      left out, a dihedral angle under --draw-below), mesh again up to N\n"
     "                      times with the octree's lattice shifted against the part, within\n"
     "                      the work bound left (0..2, default 2; report.json lattice_draw)\n"
     "  --draw-below DEG    the dihedral angle under which a mesh counts as degraded for\n"
