@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "core/orthtree.hpp"
-#include "core/stage_timer.hpp"
 #include "core/quality.hpp"
+#include "core/stage_timer.hpp"
 #include "core/validate.hpp"
 #include "dim3/boundary_octants.hpp"
 #include "dim3/hex_dominant.hpp"
@@ -234,20 +234,23 @@ struct Options3d {
   /// there stands.
   bool align_planar_faces = true;
   /// Lattice draws: where the mesh is degraded (refused; one level finer than asked; the thin
-  /// parts left out; the buffer rule's try; a dihedral angle under draw_min_dihedral_deg) the
-  /// run is made again, up to this many times, with the root cube shifted against the surface
-  /// (lattice_draw_shift), and the first mesh that is not degraded stands; when none is, the
-  /// valid one that loses the least volume (Result3d::lattice_draw). A mesh at the level asked
-  /// that loses more volume than a degraded one still stands over it (its parts thinner than
-  /// the octants are a matter of the level). Which tries fail depends on
-  /// where the lattice planes cut the part (fandisk turned 180 degrees about x, the same
-  /// lattice turned with it, is meshed only with its thin parts left out at level 5; shifted by
-  /// a hundredth of the root's side, at 15 degrees). A draw runs the tries at the level asked
+  /// parts left out; only the buffer rule's try stood; a dihedral angle under
+  /// draw_min_dihedral_deg) the run is made again, up to this many times, with the root cube
+  /// shifted against the surface (lattice_draw_shift). The first mesh that is not degraded
+  /// stands; when none is, the valid one that loses the least volume (Result3d::lattice_draw).
+  /// A mesh at the level asked stands over a degraded one even where it loses more volume (its
+  /// parts thinner than the octants are a matter of the level). Which tries fail depends on
+  /// where the lattice planes cut the part: fandisk turned 180 degrees about x (the lattice
+  /// turns with it) is meshed at level 5 only with its thin parts left out, and at 15 degrees
+  /// with the root shifted by a hundredth of its side. A draw runs the tries at the level asked
   /// within what the runs before it left of the work bound (Options3d::effort), without the
-  /// fallbacks after a refusal. For a part meshed in the frame of its planar faces, the second
-  /// run is the frame's draw, the third the given axes (with a work bound of their own). 0:
-  /// one lattice (as before session 34).
+  /// fallbacks after a refusal. For a part meshed in the frame of its planar faces the second
+  /// run is the frame's draw, the third the given axes (with a work bound of their own).
+  /// 0: one lattice, as before session 34.
   int lattice_draws = 2;
+  /// The smallest dihedral angle (degrees) of a mesh that is not degraded for the draws. 15
+  /// makes every orientation of fandisk and spool at level 5 reach 15, at up to 30x the time of
+  /// a run (README, "Lattice draws").
   double draw_min_dihedral_deg = 10.0;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
