@@ -12,6 +12,7 @@
 #include <optional>
 #include <span>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include "core/fnv_lanes.hpp"
@@ -217,10 +218,12 @@ template <int Dim> Box<Dim> inflated_box(std::initializer_list<Point<Dim>> corne
 
 
 /// facet_uses(solid) grouped by key: the groups in key order, each group's uses in (element,
-/// local facet) order, the same as facet_uses gives them. A solid of tetrahedra is held at 12
-/// bytes a use (the smallest node implied by a bucket, the other two and a packed element and
-/// facet), its FacetUse records made per group: facet_uses' 24 bytes a use (96 a tetrahedron)
-/// were the CLI's memory peak in the validation (sphere966 level 6).
+/// local facet) order, the same as facet_uses gives them. A solid of tetrahedra is held at 4
+/// bytes a use: the uses bucketed by the key's smallest node, each an element and local facet
+/// (element << 2 | facet), ordered within the bucket by the rest of the key, which is made again
+/// from the element when needed. facet_uses' 24 bytes a use (96 a tetrahedron) were the CLI's
+/// memory peak in the validation (sphere966 level 6), and the keys stored beside the uses (12
+/// bytes a use) were still its peak in session 35 (72 MB of 163 MB at 1.5 M tetrahedra).
 class FacetGroups {
  public:
   explicit FacetGroups(const Elements& els) : els_(els) {
@@ -234,38 +237,30 @@ class FacetGroups {
     std::int32_t top = -1;  // node ids are in range (validate checked the elements)
     for (const VertexId v : els.node) top = std::max(top, v.v);
     start_.assign(static_cast<std::size_t>(top) + 2, 0);
-    // Calls visit(sorted key nodes a <= b <= c, element << 2 | local facet) per use, in
-    // (element, local facet) order. Facet f of a tetrahedron (Gmsh's table) is the triple
-    // without node 3 - f; its key is that triple sorted.
     const auto each_use = [&](auto&& visit) {
-      for (std::size_t e = 0; e < els.size(); ++e) {
-        const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
-        for (int f = 0; f < 4; ++f) {
-          std::int32_t t[3], m = 0;
-          for (int i = 0; i < 4; ++i)
-            if (i != 3 - f) t[m++] = v[i].v;
-          if (t[0] > t[1]) std::swap(t[0], t[1]);
-          if (t[1] > t[2]) std::swap(t[1], t[2]);
-          if (t[0] > t[1]) std::swap(t[0], t[1]);
-          visit(t[0], t[1], t[2], static_cast<std::uint32_t>(e << 2 | std::size_t(f)));
+      for (std::size_t e = 0; e < els.size(); ++e)
+        for (std::uint32_t f = 0; f < 4; ++f) {
+          const std::uint32_t id = static_cast<std::uint32_t>(e << 2) | f;
+          visit(key_of_use(id)[0], id);
         }
-      }
     };
-    each_use([&](std::int32_t a, std::int32_t, std::int32_t, std::uint32_t) { ++start_[static_cast<std::size_t>(a) + 1]; });
+    each_use([&](std::int32_t a, std::uint32_t) { ++start_[static_cast<std::size_t>(a) + 1]; });
     for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
-    packed_.resize(start_.back());
+    ids_.resize(start_.back());
     {
       std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
-      each_use([&](std::int32_t a, std::int32_t b, std::int32_t c, std::uint32_t id) {
-        packed_[fill[static_cast<std::size_t>(a)]++] = {b, c, id};
-      });
+      each_use([&](std::int32_t a, std::uint32_t id) { ids_[fill[static_cast<std::size_t>(a)]++] = id; });
     }
     // Generation order is (element, local facet): a stable sort by the rest of the key.
-    const auto less = [](const Packed& x, const Packed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; };
+    std::vector<Keyed> bucket;
     for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
-      const auto first = packed_.begin() + start_[b], last = packed_.begin() + start_[b + 1];
-      stable_sort_short(first, last, less);
-      for (auto i = first; i < last; ++i) n_groups_ += i == first || less(*(i - 1), *i);
+      keyed_bucket(b, bucket);
+      stable_sort_short(bucket.begin(), bucket.end(),
+                        [](const Keyed& x, const Keyed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; });
+      for (std::size_t i = 0; i < bucket.size(); ++i) {
+        ids_[start_[b] + i] = bucket[i].id;
+        n_groups_ += i == 0 || !same_key(bucket[i - 1], bucket[i]);
+      }
     }
   }
 
@@ -283,35 +278,64 @@ class FacetGroups {
       return;
     }
     std::vector<FacetUse> g;
-    for (std::size_t b = 0; b + 1 < start_.size(); ++b)
-      for (std::uint32_t i = start_[b]; i < start_[b + 1];) {
-        std::uint32_t j = i + 1;
-        while (j < start_[b + 1] && packed_[j].k1 == packed_[i].k1 && packed_[j].k2 == packed_[i].k2) ++j;
+    std::vector<Keyed> bucket;
+    for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
+      keyed_bucket(b, bucket);
+      for (std::size_t i = 0; i < bucket.size();) {
+        std::size_t j = i + 1;
+        while (j < bucket.size() && same_key(bucket[j], bucket[i])) ++j;
         g.clear();
-        for (std::uint32_t k = i; k < j; ++k) {
-          const ElemId e{static_cast<std::int32_t>(packed_[k].id >> 2)};
-          const int local = static_cast<int>(packed_[k].id & 3u);
+        for (std::size_t k = i; k < j; ++k) {
+          const ElemId e{static_cast<std::int32_t>(bucket[k].id >> 2)};
+          const int local = static_cast<int>(bucket[k].id & 3u);
           FacetUse u{FacetKey{}, e, static_cast<std::int8_t>(local),
                      static_cast<std::int8_t>(orientation_of(facet_of(els_, e, local)))};
-          u.key.v = {static_cast<std::int32_t>(b), packed_[k].k1, packed_[k].k2, -1};
+          u.key.v = {static_cast<std::int32_t>(b), bucket[k].k1, bucket[k].k2, -1};
           g.push_back(u);
         }
         group(std::span<const FacetUse>(g));
         i = j;
       }
+    }
   }
 
  private:
-  struct Packed {
+  struct Keyed {
     std::int32_t k1, k2;  ///< the key's second and third node
     std::uint32_t id;     ///< element << 2 | local facet
   };
+  static bool same_key(const Keyed& x, const Keyed& y) { return x.k1 == y.k1 && x.k2 == y.k2; }
+
+  /// The sorted key (a <= b <= c) of use id: facet f of a tetrahedron (Gmsh's table) is the
+  /// triple without node 3 - f.
+  std::array<std::int32_t, 3> key_of_use(std::uint32_t id) const {
+    const VertexId* v = els_.nodes(ElemId{static_cast<std::int32_t>(id >> 2)});
+    const int skip = 3 - static_cast<int>(id & 3u);
+    std::array<std::int32_t, 3> t{};
+    int m = 0;
+    for (int i = 0; i < 4; ++i)
+      if (i != skip) t[m++] = v[i].v;
+    if (t[0] > t[1]) std::swap(t[0], t[1]);
+    if (t[1] > t[2]) std::swap(t[1], t[2]);
+    if (t[0] > t[1]) std::swap(t[0], t[1]);
+    return t;
+  }
+
+  /// Bucket b's uses with the rest of their keys, in the order held.
+  void keyed_bucket(std::size_t b, std::vector<Keyed>& out) const {
+    out.clear();
+    for (std::uint32_t i = start_[b]; i < start_[b + 1]; ++i) {
+      const std::array<std::int32_t, 3> k = key_of_use(ids_[i]);
+      out.push_back({k[1], k[2], ids_[i]});
+    }
+  }
+
   const Elements& els_;
   bool tets_ = false;
   std::size_t n_groups_ = 0;
   std::vector<FacetUse> uses_;         ///< other element types: facet_uses
-  std::vector<std::uint32_t> start_;   ///< tetrahedra: bucket b (smallest node b) is packed_[start_[b], start_[b + 1])
-  std::vector<Packed> packed_;
+  std::vector<std::uint32_t> start_;   ///< tetrahedra: bucket b (smallest node b) is ids_[start_[b], start_[b + 1])
+  std::vector<std::uint32_t> ids_;     ///< element << 2 | local facet, by (key, element, local facet)
 };
 }  // namespace
 
@@ -483,18 +507,19 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   std::vector<FacetUse> boundary;  // used once; sorted by key
   std::size_t n_unique_facets = 0;  // (a count: the list of keys was 24 B/element at the CLI's peak)
   // 3D: each distinct facet's first use, in key order, for the hanging-node check below (the
-  // groups are freed after this loop, not kept to the end beside the edge list).
-  struct FirstUse {
-    ElemId elem;
-    std::int8_t local = 0;
-  };
-  std::vector<FirstUse> first_uses;
+  // groups are freed after this loop, not kept to the end beside the edge list), 4 bytes each:
+  // element << 3 | local facet.
+  if (Dim == 3 && mesh.solid.size() >= (std::size_t(1) << 29))
+    throw std::length_error("validate: more than 2^29 solid elements (" + std::to_string(mesh.solid.size()) + ")");
+  std::vector<std::uint32_t> first_uses;
+  [[maybe_unused]] const auto first_elem = [&](std::size_t i) { return ElemId{static_cast<std::int32_t>(first_uses[i] >> 3)}; };
+  [[maybe_unused]] const auto first_local = [&](std::size_t i) { return static_cast<int>(first_uses[i] & 7u); };
   {
     const FacetGroups groups(mesh.solid);
     if constexpr (Dim == 3) first_uses.reserve(groups.n_groups());
     groups.for_each([&](std::span<const FacetUse> g) {
       ++n_unique_facets;
-      if constexpr (Dim == 3) first_uses.push_back({g[0].elem, g[0].local});
+      if constexpr (Dim == 3) first_uses.push_back(static_cast<std::uint32_t>(g[0].elem.v) << 3 | static_cast<std::uint32_t>(g[0].local));
       if (g.size() == 1) {
         boundary.push_back(g[0]);
       } else if (g.size() > 2 || g[0].orientation == g[1].orientation) {
@@ -670,7 +695,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     if constexpr (Dim == 3) {
       // Calls at(c) for every node c on the interior of the i-th distinct facet.
       const auto on_interior = [&](std::size_t i, const auto& at) {
-        const Facet f = facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local);
+        const Facet f = facet_of(mesh.solid, first_elem(i), first_local(i));
         Box<3> box = Box<3>::empty();
         for (int k = 0; k < f.n; ++k) box.expand(pts[f.node[k].v]);
         const double h = facet_size(f, pts);  // once per facet, not once per node tested
@@ -701,7 +726,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
           on_interior(i, [&](std::int32_t c) { hits.push_back(c); });
           std::sort(hits.begin(), hits.end());
           for (const std::int32_t c : hits)
-            report(c, "facet " + fmt_key(key_of(facet_of(mesh.solid, first_uses[i].elem, first_uses[i].local))));
+            report(c, "facet " + fmt_key(key_of(facet_of(mesh.solid, first_elem(i), first_local(i)))));
         }
     }
   }

@@ -40,7 +40,10 @@ std::vector<std::pair<int, int>> boundary_ref(const Elements& els) {
 
 void check_same_as_ref(const Elements& els) {
   CHECK(same_uses(facet_uses(els), facet_uses_ref(els)));
-  CHECK(unique_edges(els) == unique_edges_ref(els));
+  const std::vector<std::array<VertexId, 2>> edges = unique_edges_ref(els);
+  CHECK(unique_edges(els) == edges);
+  for (const std::size_t run : {1, 2, 5, 17})  // runs of nodes: several passes, long buckets alone
+    CHECK(unique_edges(els, run) == edges);
   std::vector<std::pair<int, int>> fast;
   for (const BoundaryFacet& b : boundary_facets(els)) {
     fast.emplace_back(b.elem.v, b.local);
