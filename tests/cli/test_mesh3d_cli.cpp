@@ -67,6 +67,11 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
   // The work bound's count: one tree built on (sphere966 L4 needs no repair).
   const auto counts = nlohmann::json::parse(read_text(dir / "1" / "report.json"))["counts"];
   CHECK(counts["octants_built"] == counts["leaves"]);
+  // The validation and the quality summary that rank the run are stages of their own, not
+  // time of tries not kept (sphere966 L4's first try stands).
+  const auto times = nlohmann::json::parse(read_text(dir / "1" / "report.json"))["timings_s"];
+  for (const char* stage : {"validation", "quality summary", "tries_not_kept"}) CHECK(times.contains(stage));
+  CHECK(times["validation"].get<double>() > 0.0);
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --effort 0.5") == 2);
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --threads 0") == 2);
   CHECK(!std::filesystem::exists(dir / "0"));
