@@ -53,11 +53,15 @@ const char* help_text =
     "                      at an angle to them is meshed in the frame of those faces and\n"
     "                      turned back: report.json \"frame\")\n"
     "  --lattice-draws N   where the mesh is degraded (refused, one level finer, thin parts\n"
-    "                      left out, a dihedral angle under --draw-below), mesh again up to N\n"
-    "                      times with the octree's lattice shifted against the part, within\n"
-    "                      the work bound left (0..2, default 2; report.json lattice_draw)\n"
+    "                      left out, a dihedral angle under --draw-below, more of the volume\n"
+    "                      lost than --draw-lost), mesh again up to N times with the\n"
+    "                      octree's lattice shifted against the part, within the work\n"
+    "                      bound left (0..2, default 2; report.json lattice_draw)\n"
     "  --draw-below DEG    the dihedral angle under which a mesh counts as degraded for\n"
     "                      the lattice draws (0..30, default 10)\n"
+    "  --draw-lost PCT     the share of the volume a mesh may lose (thin parts not meshed)\n"
+    "                      before it counts as degraded for the lattice draws (0..100,\n"
+    "                      default 10)\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -108,7 +112,7 @@ int run(const std::vector<std::string>& argv) {
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
-                   "--lattice-draws", "--draw-below"});
+                   "--lattice-draws", "--draw-below", "--draw-lost"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -132,6 +136,7 @@ int run(const std::vector<std::string>& argv) {
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);
   opt.draw_min_dihedral_deg = args.real_or("--draw-below", opt.draw_min_dihedral_deg, 0.0, 30.0);
+  opt.draw_max_volume_error = args.real_or("--draw-lost", 100 * opt.draw_max_volume_error, 0.0, 100.0) / 100;
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
@@ -216,6 +221,7 @@ int run(const std::vector<std::string>& argv) {
                     {"frame_refused", r.frame_refused},
                     {"lattice_draws", opt.lattice_draws},
                     {"draw_below_deg", opt.draw_min_dihedral_deg},
+                    {"draw_lost_pct", 100 * opt.draw_max_volume_error},
                     {"lattice_draws_run", r.lattice_draws_run},
                     {"lattice_draw", r.lattice_draw}};
   {

@@ -413,6 +413,11 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
     else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
     else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
     else if (min_deg < opt.draw_min_dihedral_deg) d.degraded = "a dihedral angle of " + std::to_string(min_deg) + " deg";
+    else if (d.error > opt.draw_max_volume_error) {
+      char lost[64];
+      std::snprintf(lost, sizeof lost, "%.2f%% of the volume lost", 100 * d.error);
+      d.degraded = lost;
+    }
     d.rank = !v.valid ? 2 : d.degraded.empty() ? 0 : 1;
     if (!v.valid) d.degraded = "not valid (" + v.summary() + ")";
     r.lattice_draw = k;
@@ -501,7 +506,6 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     runs.push_back(run_drawn(on, opt, p.draw, limit, progress));
     Drawn& d = runs.back();
     if (d.r) {
-      d.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
       d.r->frame = frame;
       if (p.in_frame) {
         // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to
@@ -536,9 +540,12 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   if (runs.size() > 1 && progress) {
     char lost[64];
     std::snprintf(lost, sizeof lost, "%.2f%% of the volume lost", 100 * b.error);
+    const std::string how = b.degraded.empty() ? std::string("not degraded") : b.degraded;
     progress("of " + std::to_string(runs.size()) + " runs, run " + std::to_string(best + 1) + " stands (" +
-             (b.degraded.empty() ? std::string("not degraded") : b.degraded) + ", " + lost + ")");
+             (how == lost ? how : how + ", " + lost) + ")");
   }
+  // The runs made after the first, whichever stands (a run's own index when it was made).
+  b.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
   return std::move(*b.r);
 }
 

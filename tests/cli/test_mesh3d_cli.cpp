@@ -151,6 +151,7 @@ TEST_CASE("mesh3d --lattice-draws: the report names the draws; a mesh that is no
   CHECK(drawn["options"]["lattice_draws"] == 2);
   CHECK(one["options"]["lattice_draws"] == 0);
   CHECK(drawn["options"]["draw_below_deg"].get<double>() == 10.0);  // Options3d::draw_min_dihedral_deg
+  CHECK(drawn["options"]["draw_lost_pct"].get<double>() == 10.0);    // Options3d::draw_max_volume_error
   for (const auto& r : {drawn, one}) {
     CHECK(r["options"]["lattice_draws_run"] == 0);
     CHECK(r["options"]["lattice_draw"] == 0);
@@ -163,7 +164,19 @@ TEST_CASE("mesh3d --lattice-draws: the report names the draws; a mesh that is no
                    out.string() + "'") == 2);
   CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --draw-below 31 -o '" +
                    out.string() + "'") == 2);
+  CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --draw-lost 101 -o '" +
+                   out.string() + "'") == 2);
   CHECK_FALSE(std::filesystem::exists(out));
+  // No volume lost allowed: the sphere's 3.34% makes every run degraded, both draws are made,
+  // and the first lattice's, which loses the least, stands.
+  const auto strict = runs.dir / "d";
+  REQUIRE(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --level 3 --quiet --threads 1 --draw-lost 0 -o '" +
+                     strict.string() + "'") == 0);
+  const auto r = nlohmann::json::parse(read_text(strict / "report.json"));
+  CHECK(r["options"]["draw_lost_pct"].get<double>() == 0.0);
+  CHECK(r["options"]["lattice_draws_run"] == 2);
+  CHECK(r["options"]["lattice_draw"] == 0);
+  CHECK(read_text(strict / "mesh.msh") == read_text(runs.msh("a")));
 }
 
 TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in its own", "[cli][mesh3d]") {

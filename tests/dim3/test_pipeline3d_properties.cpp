@@ -61,7 +61,8 @@ double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 /// Meshes `surface` (validated and oriented here, as the CLI does) at `level` and measures it;
 /// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off).
 Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws,
-                     double draw_below = Options3d{}.draw_min_dihedral_deg) {
+                     double draw_below = Options3d{}.draw_min_dihedral_deg,
+                     double draw_lost = Options3d{}.draw_max_volume_error) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
@@ -69,6 +70,7 @@ Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int la
   opt.align_planar_faces = !given_axes;
   opt.lattice_draws = lattice_draws;
   opt.draw_min_dihedral_deg = draw_below;
+  opt.draw_max_volume_error = draw_lost;
   Outcome3 out{mesh3d(s, opt), {}};
   const Mesh<3>& m = out.r.fe.mesh;
   const Box<3> bb = s.bounding_box();
@@ -315,7 +317,8 @@ std::string fallbacks_of(const Result3d& r) {
 // [FEBEMESH_SURVEY_KEEP=FLAG] [FEBEMESH_SURVEY_GIVEN_AXES=1] [FEBEMESH_SURVEY_LATTICE_DRAWS=N]
 // [RC_PARAMS="seed=S"] test_dim3 "[.survey]" (GIVEN_AXES: Options3d::align_planar_faces off;
 // LATTICE_DRAWS: Options3d::lattice_draws, 0 for one lattice; FEBEMESH_SURVEY_DRAW_BELOW=DEG:
-// Options3d::draw_min_dihedral_deg): runs N generated cases
+// Options3d::draw_min_dihedral_deg; FEBEMESH_SURVEY_DRAW_LOST=PCT: draw_max_volume_error in
+// percent): runs N generated cases
 // of the family (the same generators and sizes as the properties above), prints every case with
 // the fallbacks that made its mesh, every refused or invalid one with why and, with
 // FEBEMESH_SURVEY_DIR, writes those there as OFF files (unshrunk), and the valid ones whose
@@ -336,6 +339,8 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
   const int lattice_draws = draws_env ? std::atoi(draws_env) : Options3d{}.lattice_draws;
   const char* below_env = std::getenv("FEBEMESH_SURVEY_DRAW_BELOW");
   const double draw_below = below_env ? std::atof(below_env) : Options3d{}.draw_min_dihedral_deg;
+  const char* lost_env = std::getenv("FEBEMESH_SURVEY_DRAW_LOST");
+  const double draw_lost = lost_env ? std::atof(lost_env) / 100 : Options3d{}.draw_max_volume_error;
   rc::detail::TestParams params = rc::detail::configuration().testParams;
   params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
   params.disableShrinking = true;
@@ -348,11 +353,13 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
         const SurfaceSpec spec = *gen;
         const long index = n++;
         std::string why, how;
+        double lost = -1.0;
         const auto t0 = std::chrono::steady_clock::now();
         try {
-          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws, draw_below);
+          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws, draw_below, draw_lost);
           ++tally.cases;
           how = fallbacks_of(out.r);
+          lost = std::abs(out.fe_volume - out.surface_volume) / std::abs(out.surface_volume);
           if (!out.v.valid) why = "INVALID: " + out.v.summary();
           else if (std::abs(out.fe_volume - out.be_volume) > out.round_off) why = "volume gap";
         } catch (const GeometryError& e) {
@@ -361,7 +368,7 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
           why = std::string("LimitError: ") + e.what();
         }
         const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        std::printf("[survey] case %ld %s %.1f s%s\n", index, why.empty() ? "ok" : "FAILED", sec,
+        std::printf("[survey] case %ld %s %.1f s, %.2f%% lost%s\n", index, why.empty() ? "ok" : "FAILED", sec, 100 * lost,
                     how.empty() ? "" : (" (" + how + ")").c_str());
         if (why.empty() && dir && keep && ("," + how + ",").find("," + std::string(keep) + ",") != std::string::npos)
           std::ofstream(fs::path(dir) / (k + "-" + std::to_string(index) + ".off")) << test::to_off(spec);
