@@ -226,7 +226,7 @@ template <int Dim> Box<Dim> inflated_box(std::initializer_list<Point<Dim>> corne
 /// bytes a use) were still its peak in session 35 (72 MB of 163 MB at 1.5 M tetrahedra).
 class FacetGroups {
  public:
-  explicit FacetGroups(const Elements& els) : els_(els) {
+  FacetGroups(const Elements& els, int n_threads) : els_(els) {
     tets_ = els.size() < (std::size_t(1) << 29) &&
             std::all_of(els.type.begin(), els.type.end(), [](ElemType t) { return t == ElemType::Tet4; });
     if (!tets_) {
@@ -251,17 +251,25 @@ class FacetGroups {
       std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
       each_use([&](std::int32_t a, std::uint32_t id) { ids_[fill[static_cast<std::size_t>(a)]++] = id; });
     }
-    // Generation order is (element, local facet): a stable sort by the rest of the key.
-    std::vector<Keyed> bucket;
-    for (std::size_t b = 0; b + 1 < start_.size(); ++b) {
-      keyed_bucket(b, bucket);
-      stable_sort_short(bucket.begin(), bucket.end(),
-                        [](const Keyed& x, const Keyed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; });
-      for (std::size_t i = 0; i < bucket.size(); ++i) {
-        ids_[start_[b] + i] = bucket[i].id;
-        n_groups_ += i == 0 || !same_key(bucket[i - 1], bucket[i]);
-      }
-    }
+    // Generation order is (element, local facet): a stable sort by the rest of the key. Each
+    // bucket on its own (its range of ids_), so in chunks of buckets on n_threads.
+    std::atomic<std::size_t> n_groups{0};
+    for_each_chunk_balanced(start_.size() - 1, std::size_t(1) << 12, n_threads, [&](auto&& next) {
+      std::vector<Keyed> bucket;
+      std::size_t groups = 0;
+      for (std::size_t begin = 0, end = 0; next(begin, end);)
+        for (std::size_t b = begin; b < end; ++b) {
+          keyed_bucket(b, bucket);
+          stable_sort_short(bucket.begin(), bucket.end(),
+                            [](const Keyed& x, const Keyed& y) { return x.k1 != y.k1 ? x.k1 < y.k1 : x.k2 < y.k2; });
+          for (std::size_t i = 0; i < bucket.size(); ++i) {
+            ids_[start_[b] + i] = bucket[i].id;
+            groups += i == 0 || !same_key(bucket[i - 1], bucket[i]);
+          }
+        }
+      n_groups += groups;
+    });
+    n_groups_ = n_groups.load();
   }
 
   std::size_t n_groups() const { return n_groups_; }
@@ -515,7 +523,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   [[maybe_unused]] const auto first_elem = [&](std::size_t i) { return ElemId{static_cast<std::int32_t>(first_uses[i] >> 3)}; };
   [[maybe_unused]] const auto first_local = [&](std::size_t i) { return static_cast<int>(first_uses[i] & 7u); };
   {
-    const FacetGroups groups(mesh.solid);
+    const FacetGroups groups(mesh.solid, options.n_threads);
     if constexpr (Dim == 3) first_uses.reserve(groups.n_groups());
     groups.for_each([&](std::span<const FacetUse> g) {
       ++n_unique_facets;
