@@ -187,6 +187,13 @@ double volume_error(const Mesh<3>& m, const SurfaceBoundary& s, int n_threads) {
   return std::abs(solid_measure<3>(m, n_threads) - s.volume()) / std::abs(s.volume());
 }
 
+/// "12.34% of the volume lost", for the progress report.
+std::string volume_lost(double error) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.2f%% of the volume lost", 100 * error);
+  return text;
+}
+
 /// mesh3d_tries, and when every try is refused although they built on fewer octants than
 /// opt.min_effort_octants (a coarse level: the features are a couple of octants across), once
 /// more one level finer within that many octants (Result3d::level_raised). Measured: the 4x4x4
@@ -413,11 +420,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
     else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
     else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
     else if (min_deg < opt.draw_min_dihedral_deg) d.degraded = "a dihedral angle of " + std::to_string(min_deg) + " deg";
-    else if (d.error > opt.draw_max_volume_error) {
-      char lost[64];
-      std::snprintf(lost, sizeof lost, "%.2f%% of the volume lost", 100 * d.error);
-      d.degraded = lost;
-    }
+    else if (d.error > opt.draw_max_volume_error) d.degraded = volume_lost(d.error);
     d.rank = !v.valid ? 2 : d.degraded.empty() ? 0 : 1;
     if (!v.valid) d.degraded = "not valid (" + v.summary() + ")";
     r.lattice_draw = k;
@@ -538,9 +541,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     throw GeometryError(reasons);
   }
   if (runs.size() > 1 && progress) {
-    char lost[64];
-    std::snprintf(lost, sizeof lost, "%.2f%% of the volume lost", 100 * b.error);
-    const std::string how = b.degraded.empty() ? std::string("not degraded") : b.degraded;
+    const std::string how = b.degraded.empty() ? std::string("not degraded") : b.degraded, lost = volume_lost(b.error);
     progress("of " + std::to_string(runs.size()) + " runs, run " + std::to_string(best + 1) + " stands (" +
              (how == lost ? how : how + ", " + lost) + ")");
   }
