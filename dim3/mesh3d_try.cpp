@@ -325,7 +325,11 @@ struct RepairLoop {
     if (effort.used > effort.limit) {
       const std::string why = "building on " + std::to_string(tree.n_leaves()) + " more octants would bring this run to " +
                               std::to_string(effort.used) + ", over its work bound of " + std::to_string(effort.limit) +
-                              " (" + std::to_string(static_cast<int>(opt.effort)) + "x the first tree's octants, --effort)";
+                              " (" +
+                              (effort.limit_origin.empty()
+                                   ? std::to_string(static_cast<int>(opt.effort)) + "x the first tree's octants, --effort"
+                                   : effort.limit_origin) +
+                              ")";
       if (saved) {
         say("repair " + std::to_string(attempt + 1) + ": " + why + "; keeping the mesh before the refinement");
         return true;

@@ -17,6 +17,9 @@ namespace febemesh::dim3 {
 struct Effort {
   std::size_t used = 0;
   std::size_t limit = 0;
+  /// Where a limit given from outside comes from, for the message past it (empty: the run's
+  /// own, Options3d::effort x its first tree).
+  std::string limit_origin;
   bool first_tree_built = false;  ///< the run's first tree (Options3d::thickness_probe looks at it only)
   /// Why the probe did not stand, when it ran (Options3d::thickness_probe): the thickness try
   /// after a refusal would begin with the probe's tree again. Empty: no probe, or it stood.

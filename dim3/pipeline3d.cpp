@@ -389,6 +389,7 @@ struct Drawn {
   bool limit_error = false;   ///< refused by a bound (LimitError), not by the geometry
   Effort effort;
   int rank = 3;  ///< 0 not degraded, 1 degraded, 2 not valid, 3 refused
+  bool volume_only = false;  ///< degraded by the volume it lost, and by nothing else
   double error = std::numeric_limits<double>::infinity();  ///< volume error
   std::string degraded;                                   ///< how, for the progress report
   int draw = 0;                                           ///< lattice_draw_shift(draw)
@@ -396,10 +397,12 @@ struct Drawn {
 
 /// mesh3d_in_axes on `s` with its root cube shifted by lattice_draw_shift(k), within `limit`
 /// octants (0: the work bound of the run's first tree), ranked on `s` as meshed.
-Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, const Progress3& progress) {
+Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, std::string limit_origin,
+                const Progress3& progress) {
   Drawn d;
   d.draw = k;
   d.effort.limit = limit;
+  d.effort.limit_origin = std::move(limit_origin);
   const P3 shift0 = s.root_shift();
   s.set_root_shift(shift0 + lattice_draw_shift(k));
   Options3d o = opt;
@@ -420,7 +423,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
     else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
     else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
     else if (min_deg < opt.draw_min_dihedral_deg) d.degraded = "a dihedral angle of " + std::to_string(min_deg) + " deg";
-    else if (d.error > opt.draw_max_volume_error) d.degraded = volume_lost(d.error);
+    else if (d.error > opt.draw_max_volume_error) d.degraded = volume_lost(d.error), d.volume_only = v.valid;
     d.rank = !v.valid ? 2 : d.degraded.empty() ? 0 : 1;
     if (!v.valid) d.degraded = "not valid (" + v.summary() + ")";
     r.lattice_draw = k;
@@ -487,10 +490,28 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     const Plan& p = plan[i];
     SurfaceBoundary& on = p.in_frame ? *turned : s;
     std::size_t limit = 0;
+    std::string origin;
     if (p.draw > 0) {
       limit = left_of(runs.back().effort);
+      origin = runs.back().effort.limit_origin.empty() ? "what the runs before it left of the work bound"
+                                                       : runs.back().effort.limit_origin;
+      // The first draw after a run of these axes that lost only volume: at most
+      // volume_draw_effort x that run's octants, which the next draw shares.
+      const Drawn& first = runs.back();  // (draw 0 of these axes, when p.draw is 1)
+      const double cap = opt.volume_draw_effort * static_cast<double>(first.effort.used);
+      if (p.draw == 1 && first.volume_only && opt.volume_draw_effort > 0 && cap < static_cast<double>(limit)) {
+        limit = static_cast<std::size_t>(cap);
+        char text[160];
+        std::snprintf(text, sizeof text, "%gx the octants of the first run, which lost only volume", opt.volume_draw_effort);
+        origin = text;
+      }
       if (limit == 0) {
-        if (progress) progress("lattice draw " + std::to_string(p.draw) + ": no work bound left; not made");
+        if (progress) {
+          const Drawn& last = runs.back();
+          progress((last.r || last.draw == 0 ? std::string()
+                                             : "lattice draw " + std::to_string(last.draw) + ": refused (" + last.why + "); ") +
+                   "lattice draw " + std::to_string(p.draw) + ": no work bound left; not made");
+        }
         continue;
       }
     }
@@ -506,7 +527,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       else
         progress("in the frame of the planar faces: " + what + "; once more in the given axes");
     }
-    runs.push_back(run_drawn(on, opt, p.draw, limit, progress));
+    runs.push_back(run_drawn(on, opt, p.draw, limit, origin, progress));
     Drawn& d = runs.back();
     if (d.r) {
       d.r->frame = frame;

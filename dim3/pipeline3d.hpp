@@ -259,6 +259,16 @@ struct Options3d {
   /// lose 5-10% by their resolution alone (85 of 200 tori of the survey at level 3, seed 11),
   /// where the draws gained a point for 66% more time.
   double draw_max_volume_error = 0.10;
+  /// Where the first run of the axes is valid and degraded by its lost volume only, its draws
+  /// build on at most this times the octants that run built (Effort::used), shared as the work
+  /// bound is (0: no such bound; CLI --draw-effort). Such a draw only looks for a lattice that
+  /// keeps more of the thin parts. Rotor (session 36, one thread, CPU s): at level 4 draw 1
+  /// builds 1.03x the first run's octants and keeps 22.74% lost instead of 29.63% (draw 2 then
+  /// stops at once: 12.7 -> 6.6 s, the same mesh); at level 5 the tetrahedral run's draw 1
+  /// built 4.8x (3.58 M octants) and ended at the work bound without a mesh (the same mesh,
+  /// 184 -> 86 s), the hex-dominant run's 4.4x and kept 22.27% instead of 28.94% (with the
+  /// bound: 28.94%, 264 -> 85 s).
+  double volume_draw_effort = 2.0;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;

@@ -730,4 +730,21 @@ TEST_CASE("mesh3d's lattice draws take a mesh that loses more of the volume than
   });
   CHECK(n_lost == 2);
   CHECK(s.root_shift() == P3::Zero());
+
+  // The draws after a run that lost only volume build on at most volume_draw_effort x its
+  // octants: at half of them draw 1 is refused by that bound at its first tree, and nothing
+  // is left for draw 2. The first lattice's mesh stands.
+  opt.volume_draw_effort = 0.5;
+  lines.clear();
+  const Result3d capped = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  CHECK(capped.lattice_draws_run == 1);
+  CHECK(capped.lattice_draw == 0);
+  CHECK(capped.fe.mesh.points == first.fe.mesh.points);
+  const auto has = [&](const std::string& text) {
+    return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+  };
+  CHECK(has("lattice draw 1: refused ("));
+  CHECK(has("0.5x the octants of the first run, which lost only volume"));
+  CHECK(has("lattice draw 2: no work bound left; not made"));
+  CHECK(s.root_shift() == P3::Zero());
 }
