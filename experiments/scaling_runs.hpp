@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/process_stats.hpp"
+#include "core/quality.hpp"
 #include "core/read_msh.hpp"
 #include "core/stage_timer.hpp"
 #include "core/write_msh.hpp"
@@ -62,6 +63,7 @@ struct OurRun {
   double wall_seconds = 0.0, cpu_seconds = 0.0;
   long peak_bytes = 0;  ///< growth of the peak RSS over the run
   std::vector<StageTime> stages;  ///< the pipeline's, then "write mesh.msh"
+  double min_dihedral_deg = -1.0;  ///< 3D: the mesh's smallest dihedral angle (-1: not measured)
   double elements_per_second() const { return wall_seconds > 0 ? double(elements) / wall_seconds : 0.0; }
   double elements_per_cpu_second() const { return cpu_seconds > 0 ? double(elements) / cpu_seconds : 0.0; }
   double bytes_per_element() const { return elements ? double(peak_bytes) / double(elements) : 0.0; }
@@ -83,6 +85,7 @@ struct BaselineRun {
   double cpu_seconds = 0.0;  ///< user + system time of the baseline's process
   long peak_bytes = 0;  ///< Gmsh: its whole process's max RSS; TetGen: peak RSS growth of the child
   int trials = 0;
+  double min_dihedral_deg = -1.0;  ///< TetGen: the mesh's smallest dihedral angle, not timed (-1: not measured)
   double elements_per_second() const { return wall_seconds > 0 ? double(elements) / wall_seconds : 0.0; }
   double elements_per_cpu_second() const { return cpu_seconds > 0 ? double(elements) / cpu_seconds : 0.0; }
   double bytes_per_element() const { return elements ? double(peak_bytes) / double(elements) : 0.0; }
@@ -139,16 +142,25 @@ inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int thr
   return run;
 }
 
-inline OurRun run_ours_3d(const std::string& path, int level, int threads, const fs::path& dir) {
+/// mesh3d at `level` with the CLI's defaults; `target_dihedral_deg` as the CLI's
+/// --target-dihedral (the sweeps' aim and the edge removal's bar).
+inline OurRun run_ours_3d(const std::string& path, int level, int threads, const fs::path& dir,
+                          double target_dihedral_deg = dim3::Options3d{}.target_dihedral_deg) {
+  double min_deg = -1.0;
   OurRun run = timed_run<3>(dir, threads, [&] {
     dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
     dim3::Options3d opt;
     opt.level = level;
     opt.n_threads = threads;
+    opt.target_dihedral_deg = target_dihedral_deg;
+    opt.remove_edges_below_deg = target_dihedral_deg;
+    opt.contract_edges_below_deg = std::min(opt.contract_edges_below_deg, target_dihedral_deg);
     dim3::Result3d r = dim3::mesh3d(s, opt);
+    if (r.quality) min_deg = r.quality->min_angle_deg;  // mesh3d's summary, ranking the run
     return std::pair{std::move(r.fe.mesh), std::move(r.times)};
   });
   run.level = level;
+  run.min_dihedral_deg = min_deg;
   return run;
 }
 
@@ -247,7 +259,11 @@ inline BaselineRun run_tetgen_matched(const std::string& path, std::size_t targe
     b.wall_seconds = c.wall_seconds;
     b.cpu_seconds = children_cpu_seconds() - cpu0;
     b.peak_bytes = c.peak_memory_growth_bytes;
-    if (c.ok) b.elements = read_msh<3>(out).solid.size();
+    if (c.ok) {
+      const Mesh<3> m = read_msh<3>(out);
+      b.elements = m.solid.size();
+      b.min_dihedral_deg = summarize_quality<3>(m, 10.0).min_angle_deg;
+    }
     best = b;
     if (!b.ok || b.elements == 0) break;
     const double n = double(b.elements);
@@ -279,7 +295,7 @@ inline nlohmann::json stages_json(const OurRun& run) {
 
 /// Our run's size, times and memory (the same keys in 2D and 3D), stages included.
 inline nlohmann::json run_json(const OurRun& run) {
-  return {{"elements", run.elements},
+  nlohmann::json j = {{"elements", run.elements},
           {"nodes", run.nodes},
           {"wall_seconds", run.wall_seconds},
           {"cpu_seconds", run.cpu_seconds},
@@ -287,11 +303,13 @@ inline nlohmann::json run_json(const OurRun& run) {
           {"peak_bytes", run.peak_bytes},
           {"bytes_per_element", run.bytes_per_element()},
           {"stages", stages_json(run)}};
+  if (run.min_dihedral_deg >= 0) j["min_dihedral_deg"] = run.min_dihedral_deg;
+  return j;
 }
 
 /// A baseline tool's run with the same keys for Gmsh and TetGen.
 inline nlohmann::json baseline_json(const BaselineRun& b) {
-  return {{"ok", b.ok},
+  nlohmann::json j = {{"ok", b.ok},
           {"error", b.error},
           {"settings", b.settings},
           {"elements", b.elements},
@@ -301,6 +319,8 @@ inline nlohmann::json baseline_json(const BaselineRun& b) {
           {"peak_bytes", b.peak_bytes},
           {"bytes_per_element", b.bytes_per_element()},
           {"trials", b.trials}};
+  if (b.min_dihedral_deg >= 0) j["min_dihedral_deg"] = b.min_dihedral_deg;
+  return j;
 }
 
 /// Markdown table of the stage times (seconds, wall) of tagged runs, one column per stage name
