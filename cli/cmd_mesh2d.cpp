@@ -13,6 +13,7 @@
 
 #include "cli/args.hpp"
 #include "cli/command.hpp"
+#include "cli/limit_hint.hpp"
 #include "cli/progress.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
@@ -127,7 +128,12 @@ int run(const std::vector<std::string>& argv) {
   check_budget(curve, opt.level != no_level ? opt.level : curve.global_level(), opt.max_cells);
   info.steps.push_back({"read", since(start)});
 
-  Result2d r = mesh2d(curve, opt, progress);
+  Result2d r;
+  try {
+    r = mesh2d(curve, opt, progress);
+  } catch (const LimitError& e) {
+    throw limit_refusal(input, e);
+  }
 
   // The folder is made before the validation, so that with two threads or more mesh.msh and
   // mesh.vtu are written beside it and the fidelity measures (both only read the mesh; a mesh

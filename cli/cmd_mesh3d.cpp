@@ -24,6 +24,7 @@
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_boundary.hpp"
+#include "cli/limit_hint.hpp"
 
 namespace febemesh::cli {
 namespace {
@@ -70,6 +71,7 @@ const char* help_text =
     "  --draw-effort X     where the first run lost only volume, its draws may build on\n"
     "                      at most X times the octants it built, in all (0..1000,\n"
     "                      default 2; 0: what the work bound leaves)\n"
+    "  --max-cells N       refuse octrees of more than N octants (default 20000000)\n"
     "  --threads N         threads for refinement, classification, smoothing and the\n"
     "                      tet optimiser (default: all cores); the mesh is the same\n"
     "                      byte for byte for every N\n"
@@ -119,7 +121,7 @@ int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
-                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
+                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
@@ -147,6 +149,7 @@ int run(const std::vector<std::string>& argv) {
   opt.thickness_probe = !args.has("--no-thickness-probe");
   opt.align_planar_faces = !args.has("--given-axes");
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
+  opt.max_cells = static_cast<std::size_t>(args.real_or("--max-cells", static_cast<double>(opt.max_cells), 1e2, 1e10));
   opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);
   opt.draw_min_dihedral_deg = args.real_or("--draw-below", opt.draw_min_dihedral_deg, 0.0, 30.0);
   opt.draw_max_volume_error = args.real_or("--draw-lost", 100 * opt.draw_max_volume_error, 0.0, 100.0) / 100;
@@ -169,7 +172,7 @@ int run(const std::vector<std::string>& argv) {
   try {
     r = dim3::mesh3d(surface, opt, progress);
   } catch (const LimitError& e) {
-    throw LimitError(input + ": " + e.what());
+    throw limit_refusal(input, e);
   } catch (const GeometryError& e) {
     throw GeometryError(input + ": " + e.what());
   }

@@ -506,7 +506,10 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
         origin = text;
       }
       if (limit == 0) {
-        if (progress) {
+        // (Nothing to say after a run refused before its first tree, the octree's size: a
+        // draw's tree is as large.)
+        const bool before_any_tree = !runs.back().r && runs.back().effort.limit == 0;
+        if (progress && !before_any_tree) {
           const Drawn& last = runs.back();
           progress((last.r || last.draw == 0 ? std::string()
                                              : "lattice draw " + std::to_string(last.draw) + ": refused (" + last.why + "); ") +

@@ -3,6 +3,7 @@
 // count, and the exit statuses: 1 for bad input (one message naming the file, no folder left
 // behind), 2 for bad usage.
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -200,4 +201,28 @@ TEST_CASE("mesh2d refuses bad usage with exit 2 and points to --help", "[cli][me
   CHECK(help.status == 0);
   for (const char* opt : {"--level", "--elements", "--threads", "--binary", "exit status"})
     CHECK(help.output.find(opt) != std::string::npos);
+}
+
+TEST_CASE("mesh2d and mesh3d refuse a tree over --max-cells: the file, the reason and the flag", "[cli][mesh2d][mesh3d]") {
+  // Refused by the refinement itself (flange at level 14: ~1.9 x 10^8 quadrants; the CLI's own
+  // estimate before it lets the level through), and in 3D by --max-cells.
+  const auto dir = scratch("max_cells");
+  std::filesystem::remove_all(dir);
+  const Run r2 = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 14 --quiet");
+  INFO(r2.output);
+  CHECK(r2.status == 1);
+  CHECK(r2.output.find("refused: " + flange + ": refinement would create about") != std::string::npos);
+  CHECK(r2.output.find("--max-cells N sets the limit") != std::string::npos);
+  CHECK(std::count(r2.output.begin(), r2.output.end(), '\n') == 1);  // one message
+  CHECK_FALSE(std::filesystem::exists(dir));
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  const Run r3 = run("mesh3d '" + sphere + "' -o '" + dir.string() + "' --level 4 --max-cells 1000 --quiet");
+  INFO(r3.output);
+  CHECK(r3.status == 1);
+  CHECK(r3.output.find("refused: " + sphere + ": refinement would create about") != std::string::npos);
+  CHECK(r3.output.find("more than max_leaves = 1000") != std::string::npos);
+  CHECK(r3.output.find("--max-cells N sets the limit") != std::string::npos);
+  CHECK(std::count(r3.output.begin(), r3.output.end(), '\n') == 1);
+  CHECK_FALSE(std::filesystem::exists(dir));
+  CHECK(run("mesh3d '" + sphere + "' -o '" + dir.string() + "' --max-cells 10 --quiet").status == 2);  // under 100
 }

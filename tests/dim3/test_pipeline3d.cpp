@@ -686,8 +686,8 @@ TEST_CASE("mesh3d's lattice draws keep a refusal before any tree as it was", "[p
   }
   CHECK_FALSE(one.empty());
   CHECK(drawn == one);
-  CHECK(std::count(lines.begin(), lines.end(), "lattice draw 1: no work bound left; not made") == 1);
-  CHECK(std::count(lines.begin(), lines.end(), "lattice draw 2: no work bound left; not made") == 1);
+  // No draw, and no progress line about draws: a draw's tree would be as large.
+  CHECK(std::none_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("lattice") != std::string::npos; }));
   CHECK(s.root_shift() == P3::Zero());
 }
 
