@@ -122,7 +122,8 @@ int run(const std::vector<std::string>& argv) {
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
-                   "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral"});
+                   "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
+                   "--flat-buffer"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -148,6 +149,9 @@ int run(const std::vector<std::string>& argv) {
   // after a first tree with problems (Options3d::thickness_probe off).
   opt.thickness_probe = !args.has("--no-thickness-probe");
   opt.align_planar_faces = !args.has("--given-axes");
+  // Hidden, for experiments: Options3d::flat_buffer (interior octants whose free face lies flat
+  // within this x their size of the surface are dropped; 0, off, by default).
+  opt.flat_buffer = args.real_or("--flat-buffer", opt.flat_buffer, 0.0, 0.5);
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   opt.max_cells = static_cast<std::size_t>(args.real_or("--max-cells", static_cast<double>(opt.max_cells), 1e2, 1e10));
   opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);
@@ -217,6 +221,7 @@ int run(const std::vector<std::string>& argv) {
                     {"extra_levels", opt.extra_levels},
                     {"elements", elements},
                     {"buffer", opt.buffer},
+                    {"flat_buffer", opt.flat_buffer},
                     {"smoothing_iterations", opt.smoothing_iterations},
                     {"target_dihedral_deg", opt.target_dihedral_deg},
                     {"snap_features", opt.snap_features},

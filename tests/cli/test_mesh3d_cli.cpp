@@ -212,6 +212,26 @@ TEST_CASE("mesh3d --target-dihedral: a lower aim moves fewer nodes and removes f
   CHECK_FALSE(std::filesystem::exists(out));
 }
 
+TEST_CASE("mesh3d --flat-buffer (hidden, for experiments) reaches Options3d::flat_buffer", "[cli][mesh3d]") {
+  // spool L5 o22 (docs/measurements.md, session 36): 11.75 deg without it, 16.79 at 0.25. Here
+  // only that the option arrives: the report says it, the mesh is valid (the CLI writes no
+  // other), and on spool at level 3 it drops octants under its flat faces, so the mesh differs
+  // (sphere966 has no flat face: the same mesh).
+  const SpherePair runs("flat_buffer", 3, "--flat-buffer 0.25");
+  CHECK(runs.report("a")["options"]["flat_buffer"].get<double>() == 0.0);
+  CHECK(runs.report("b")["options"]["flat_buffer"].get<double>() == 0.25);
+  CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));
+  const std::string spool = std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off";
+  for (const char* fb : {"0", "0.25"})
+    REQUIRE(run_status("mesh3d '" + spool + "' --level 3 --quiet --threads 1 --flat-buffer " + fb + " -o '" +
+                       (runs.dir / (std::string("spool") + fb)).string() + "'") == 0);
+  CHECK(read_text(runs.dir / "spool0" / "mesh.msh") != read_text(runs.dir / "spool0.25" / "mesh.msh"));
+  const auto out = runs.dir / "c";
+  CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --flat-buffer 0.6 -o '" +
+                   out.string() + "'") == 2);
+  CHECK_FALSE(std::filesystem::exists(out));
+}
+
 TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in its own", "[cli][mesh3d]") {
   // A box 1 x 0.6 x 0.3 turned by 30 degrees about z and 40 about x: every face at an angle to
   // the given axes (Options3d::align_planar_faces, dim3/planar_frame.hpp).
