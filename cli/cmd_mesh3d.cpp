@@ -68,6 +68,10 @@ const char* help_text =
     "  --draw-lost PCT     the share of the volume a mesh may lose (thin parts not meshed)\n"
     "                      before it counts as degraded for the lattice draws (0..100,\n"
     "                      default 10)\n"
+    "  --flat-retry-below DEG  where the mesh's smallest dihedral angle is under this,\n"
+    "                      mesh once more without the interior octants whose faces lie\n"
+    "                      flat just under the surface, and keep the better (0..30,\n"
+    "                      default 15; 0: never; report.json flat_retry)\n"
     "  --draw-effort X     where the first run lost only volume, its draws may build on\n"
     "                      at most X times the octants it built, in all (0..1000,\n"
     "                      default 2; 0: what the work bound leaves)\n"
@@ -123,7 +127,7 @@ int run(const std::vector<std::string>& argv) {
                    "--binary"},
                   {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
-                   "--flat-buffer"});
+                   "--flat-buffer", "--flat-retry-below"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -158,6 +162,7 @@ int run(const std::vector<std::string>& argv) {
   opt.draw_min_dihedral_deg = args.real_or("--draw-below", opt.draw_min_dihedral_deg, 0.0, 30.0);
   opt.draw_max_volume_error = args.real_or("--draw-lost", 100 * opt.draw_max_volume_error, 0.0, 100.0) / 100;
   opt.volume_draw_effort = args.real_or("--draw-effort", opt.volume_draw_effort, 0.0, 1000.0);
+  opt.flat_retry_below_deg = args.real_or("--flat-retry-below", opt.flat_retry_below_deg, 0.0, 30.0);
   const int hw = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   opt.n_threads = args.int_or("--threads", hw, 1, 256);
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
@@ -247,6 +252,9 @@ int run(const std::vector<std::string>& argv) {
                     {"draw_lost_pct", 100 * opt.draw_max_volume_error},
                     {"draw_effort", opt.volume_draw_effort},
                     {"lattice_draws_run", r.lattice_draws_run},
+                    {"flat_retry_below_deg", opt.flat_retry_below_deg},
+                    {"flat_retry_made", r.flat_retry_made},
+                    {"flat_retry", r.flat_retry},
                     {"lattice_draw", r.lattice_draw}};
   {
     const dim3::P3 shift = dim3::lattice_draw_shift(r.lattice_draw);

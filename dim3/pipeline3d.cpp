@@ -390,15 +390,18 @@ struct Drawn {
   Effort effort;
   int rank = 3;  ///< 0 not degraded, 1 degraded, 2 not valid, 3 refused
   bool volume_only = false;  ///< degraded by the volume it lost, and by nothing else
+  bool in_frame = false;     ///< meshed in the frame of the planar faces
+  double min_deg = 0.0;      ///< its smallest dihedral angle
   double error = std::numeric_limits<double>::infinity();  ///< volume error
   std::string degraded;                                   ///< how, for the progress report
   int draw = 0;                                           ///< lattice_draw_shift(draw)
 };
 
 /// mesh3d_in_axes on `s` with its root cube shifted by lattice_draw_shift(k), within `limit`
-/// octants (0: the work bound of the run's first tree), ranked on `s` as meshed.
+/// octants (0: the work bound of the run's first tree), ranked on `s` as meshed. Draws and
+/// retries (`retry`) make no mesh after a refusal (mesh3d_in_axes' `draw`).
 Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, std::string limit_origin,
-                const Progress3& progress) {
+                const Progress3& progress, bool retry = false) {
   Drawn d;
   d.draw = k;
   d.effort.limit = limit;
@@ -408,7 +411,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
   Options3d o = opt;
   if (k > 0) o.raise_levels = 0;  // a level raise is degraded anyway
   try {
-    Result3d r = mesh3d_in_axes(s, o, d.effort, k > 0, progress);
+    Result3d r = mesh3d_in_axes(s, o, d.effort, k > 0 || retry, progress);
     // Timed as stages of their own (report.json timings_s), not left in what the CLI counts
     // as the time of the tries not kept.
     StageTimer clock{r.times};
@@ -419,6 +422,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
     r.quality_hash = r.validation_hash;  // validation_of's hash of this mesh
     clock.lap("quality summary");
     const double min_deg = r.quality->min_angle_deg;
+    d.min_deg = min_deg;
     if (r.level_raised > 0) d.degraded = "one level finer than asked";
     else if (r.thin_parts_coarse) d.degraded = "the thin parts left out";
     else if (r.buffer_fallback) d.degraded = "only the buffer rule's try stood";
@@ -484,6 +488,25 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   std::vector<Plan> plan{{turn, 0}};
   for (int k = 1; k <= draws; ++k) plan.push_back({turn, k});
   if (turn) plan.push_back({false, 0});
+  // A run's mesh back in the given axes, and what its frame was.
+  const auto in_given_axes = [&](Drawn& d) {
+    if (!d.r) return;
+    d.r->frame = frame;
+    if (d.in_frame) {
+      // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to
+      // rounding); the report was of the turned mesh against the turned surface.
+      const Eigen::Matrix3d back = frame.to_frame.transpose();
+      for (P3& q : d.r->fe.mesh.points) q = back * q;
+      d.r->validation.reset();
+      d.r->validation_hash = 0;
+      d.r->quality.reset();
+      d.r->quality_hash = 0;
+    } else {
+      d.r->frame.turned = false;  // share_frame still says what the frame would have had
+      d.r->frame.to_frame = Eigen::Matrix3d::Identity();
+      d.r->frame_refused = turn;
+    }
+  };
   std::vector<Drawn> runs;
   std::size_t best = 0;
   for (std::size_t i = 0; i < plan.size(); ++i) {
@@ -532,23 +555,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     }
     runs.push_back(run_drawn(on, opt, p.draw, limit, origin, progress));
     Drawn& d = runs.back();
-    if (d.r) {
-      d.r->frame = frame;
-      if (p.in_frame) {
-        // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to
-        // rounding); the report was of the turned mesh against the turned surface.
-        const Eigen::Matrix3d back = frame.to_frame.transpose();
-        for (P3& q : d.r->fe.mesh.points) q = back * q;
-        d.r->validation.reset();
-        d.r->validation_hash = 0;
-        d.r->quality.reset();
-        d.r->quality_hash = 0;
-      } else {
-        d.r->frame.turned = false;  // share_frame still says what the frame would have had
-        d.r->frame.to_frame = Eigen::Matrix3d::Identity();
-        d.r->frame_refused = turn;
-      }
-    }
+    d.in_frame = p.in_frame;
+    in_given_axes(d);
     // Of the runs so far: the lowest rank, then the least volume lost, then the first.
     if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
     if (d.rank == 0) break;
@@ -571,7 +579,43 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   }
   // The runs made after the first, whichever stands (a run's own index when it was made).
   b.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
-  return std::move(*b.r);
+  if (!(b.rank <= 1 && b.min_deg < opt.flat_retry_below_deg && opt.flat_buffer < opt.flat_retry_buffer))
+    return std::move(*b.r);
+
+  // Options3d::flat_retry_below_deg: once more on the same lattice with the flat buffer.
+  Options3d f = opt;
+  f.flat_buffer = opt.flat_retry_buffer;
+  f.raise_levels = 0;  // (degraded anyway)
+  // No retry for thin parts inside it: where the flat buffer leaves a thin part without
+  // interior octants the mesh loses it and does not stand; that retry took spool L5 o21 from
+  // 13.8 to 62.6 s for a mesh that did not stand.
+  f.thin_retry_cells = 0;
+  const std::size_t limit = std::max<std::size_t>(1, b.effort.used);
+  if (progress) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "a dihedral angle of %.2f deg, under %g: once more without the interior octants whose faces lie flat "
+                  "within %g of their size of the surface",
+                  b.min_deg, opt.flat_retry_below_deg, opt.flat_retry_buffer);
+    progress(text);
+  }
+  Drawn retry = run_drawn(b.in_frame ? *turned : s, f, b.draw, limit, "the octants of the run it retries", progress, true);
+  retry.in_frame = b.in_frame;
+  in_given_axes(retry);
+  const bool better = retry.r && (retry.rank < b.rank || (retry.rank == b.rank && retry.min_deg > b.min_deg &&
+                                                          retry.error <= std::max(b.error, opt.draw_max_volume_error)));
+  if (progress) {
+    char deg[32];
+    std::snprintf(deg, sizeof deg, "%.2f deg", retry.min_deg);
+    progress(!retry.r ? "flat buffer: refused (" + retry.why + "); the mesh before it stands"
+                      : "flat buffer: " + (retry.degraded.empty() ? std::string("not degraded") : retry.degraded) + ", " + deg +
+                            ", " + volume_lost(retry.error) + "; " + (better ? "it stands" : "the mesh before it stands"));
+  }
+  Drawn& kept = better ? retry : b;
+  kept.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
+  kept.r->flat_retry_made = true;
+  kept.r->flat_retry = better;
+  return std::move(*kept.r);
 }
 
 }  // namespace febemesh::dim3

@@ -269,6 +269,18 @@ struct Options3d {
   /// 184 -> 86 s), the hex-dominant run's 4.4x and kept 22.27% instead of 28.94% (with the
   /// bound: 28.94%, 264 -> 85 s).
   double volume_draw_effort = 2.0;
+  /// Where the mesh that stands is valid and its smallest dihedral angle is under this
+  /// (degrees; 0: never), one more run on its lattice with flat_buffer at flat_retry_buffer
+  /// (within the octants it built, no level raise, no thin-part retry, no mesh after a
+  /// refusal); that mesh stands if it ranks no worse, loses no
+  /// more than draw_max_volume_error or the first's volume, and its smallest angle is larger. A
+  /// flat face a little above a lattice plane leaves interior octants whose free faces lie on it,
+  /// flat boundary octants whose slivers no node move mends (spool L5 o22: an interior node
+  /// 0.0012 under a face, two tetrahedra at 11.75 deg; 16.79 with the flat buffer). On every try
+  /// the flat buffer costs thin parts and time (docs/measurements.md, session 36), so it is a
+  /// retry. Every mesh of the bar's table is at 15 deg or more: none retries.
+  double flat_retry_below_deg = 15.0;
+  double flat_retry_buffer = 0.25;
   int n_threads = 1;
   bool hex_dominant = false;         ///< --elements hex: regroup the final tets (hex_dominant.hpp)
   HexDominantOptions hex;
@@ -316,6 +328,8 @@ struct Result3d {
   /// lattice_draw_shift(k) (the root cube's side times it).
   int lattice_draw = 0;
   int lattice_draws_run = 0;         ///< runs made after the first (draws; the given axes after a frame), whichever stands
+  bool flat_retry_made = false;      ///< Options3d::flat_retry_below_deg: the retry with the flat buffer was made
+  bool flat_retry = false;           ///< ... and its mesh stands
   std::vector<StageTime3> times;
   /// validate(fe.mesh, surface_validation(s)) where the pipeline made it of the mesh it returns
   /// (after the Escobar pass, with folds pending, the thickness retry), with content_hash of

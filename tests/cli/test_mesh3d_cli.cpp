@@ -212,7 +212,7 @@ TEST_CASE("mesh3d --target-dihedral: a lower aim moves fewer nodes and removes f
   CHECK_FALSE(std::filesystem::exists(out));
 }
 
-TEST_CASE("mesh3d --flat-buffer (hidden, for experiments) reaches Options3d::flat_buffer", "[cli][mesh3d]") {
+TEST_CASE("mesh3d --flat-buffer (hidden, for experiments) and --flat-retry-below reach Options3d", "[cli][mesh3d]") {
   // spool L5 o22 (docs/measurements.md, session 36): 11.75 deg without it, 16.79 at 0.25. Here
   // only that the option arrives: the report says it, the mesh is valid (the CLI writes no
   // other), and on spool at level 3 it drops octants under its flat faces, so the mesh differs
@@ -228,6 +228,13 @@ TEST_CASE("mesh3d --flat-buffer (hidden, for experiments) reaches Options3d::fla
   CHECK(read_text(runs.dir / "spool0" / "mesh.msh") != read_text(runs.dir / "spool0.25" / "mesh.msh"));
   const auto out = runs.dir / "c";
   CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --flat-buffer 0.6 -o '" +
+                   out.string() + "'") == 2);
+  // Its retry (Options3d::flat_retry_below_deg): the sphere at level 3 is over 15 deg, no retry.
+  const auto a = runs.report("a");
+  CHECK(a["options"]["flat_retry_below_deg"].get<double>() == 15.0);
+  CHECK(a["options"]["flat_retry_made"] == false);
+  CHECK(a["options"]["flat_retry"] == false);
+  CHECK(run_status("mesh3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off' --quiet --flat-retry-below 31 -o '" +
                    out.string() + "'") == 2);
   CHECK_FALSE(std::filesystem::exists(out));
 }

@@ -691,6 +691,32 @@ TEST_CASE("mesh3d's lattice draws keep a refusal before any tree as it was", "[p
   CHECK(s.root_shift() == P3::Zero());
 }
 
+TEST_CASE("mesh3d's flat-buffer retry: made under its angle, kept only where the smallest angle rises", "[pipeline3d]") {
+  // sphere966 at level 3 with the retry's bar above its smallest angle: the retry is made, but a
+  // sphere has no flat face, so the flat buffer drops nothing, the mesh is the same and the first
+  // stands (a retry that stands: the data test of spool level 5 turned).
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
+  Options3d opt;
+  opt.level = 3;
+  opt.flat_retry_below_deg = 0.0;
+  const Result3d plain = mesh3d(s, opt);
+  CHECK_FALSE(plain.flat_retry_made);
+  opt.flat_retry_below_deg = 35.0;
+  REQUIRE(summarize_quality(plain.fe.mesh).min_angle_deg < 35.0);
+  std::vector<std::string> lines;
+  const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  CHECK(r.flat_retry_made);
+  CHECK_FALSE(r.flat_retry);
+  CHECK(r.fe.mesh.points == plain.fe.mesh.points);
+  CHECK(r.fe.mesh.solid.node == plain.fe.mesh.solid.node);
+  const auto has = [&](const std::string& text) {
+    return std::any_of(lines.begin(), lines.end(), [&](const std::string& l) { return l.find(text) != std::string::npos; });
+  };
+  CHECK(has("under 35: once more without the interior octants whose faces lie flat"));
+  CHECK(has("; the mesh before it stands"));
+  CHECK(s.root_shift() == P3::Zero());
+}
+
 // Options3d::draw_max_volume_error: a mesh that loses more of the volume than it is degraded,
 // and the draws run; when every run is degraded the valid one that loses the least stands.
 // sphere966 at level 3 loses a little on every lattice, so with no loss allowed all three runs

@@ -62,7 +62,8 @@ double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 /// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off).
 Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws,
                      double draw_below = Options3d{}.draw_min_dihedral_deg,
-                     double draw_lost = Options3d{}.draw_max_volume_error) {
+                     double draw_lost = Options3d{}.draw_max_volume_error,
+                     double flat_retry_below = Options3d{}.flat_retry_below_deg) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
@@ -71,6 +72,7 @@ Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int la
   opt.lattice_draws = lattice_draws;
   opt.draw_min_dihedral_deg = draw_below;
   opt.draw_max_volume_error = draw_lost;
+  opt.flat_retry_below_deg = flat_retry_below;
   Outcome3 out{mesh3d(s, opt), {}};
   const Mesh<3>& m = out.r.fe.mesh;
   const Box<3> bb = s.bounding_box();
@@ -305,7 +307,9 @@ std::string fallbacks_of(const Result3d& r) {
                                                 {r.frame.turned, "planar_frame"},
                                                 {r.frame_refused, "frame_refused"},
                                                 {r.lattice_draw > 0, "lattice_draw"},
-                                                {r.lattice_draws_run > 0, "lattice_draws_run"}};
+                                                {r.lattice_draws_run > 0, "lattice_draws_run"},
+                                                {r.flat_retry_made && !r.flat_retry, "flat_retry_not_kept"},
+                                                {r.flat_retry, "flat_retry"}};
   for (const auto& [set, name] : flags)
     if (set) out += (out.empty() ? "" : ",") + std::string(name);
   return out;
@@ -318,7 +322,7 @@ std::string fallbacks_of(const Result3d& r) {
 // [RC_PARAMS="seed=S"] test_dim3 "[.survey]" (GIVEN_AXES: Options3d::align_planar_faces off;
 // LATTICE_DRAWS: Options3d::lattice_draws, 0 for one lattice; FEBEMESH_SURVEY_DRAW_BELOW=DEG:
 // Options3d::draw_min_dihedral_deg; FEBEMESH_SURVEY_DRAW_LOST=PCT: draw_max_volume_error in
-// percent): runs N generated cases
+// percent; FEBEMESH_SURVEY_FLAT_RETRY=DEG: flat_retry_below_deg): runs N generated cases
 // of the family (the same generators and sizes as the properties above), prints every case with
 // the fallbacks that made its mesh, every refused or invalid one with why and, with
 // FEBEMESH_SURVEY_DIR, writes those there as OFF files (unshrunk), and the valid ones whose
@@ -341,6 +345,8 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
   const double draw_below = below_env ? std::atof(below_env) : Options3d{}.draw_min_dihedral_deg;
   const char* lost_env = std::getenv("FEBEMESH_SURVEY_DRAW_LOST");
   const double draw_lost = lost_env ? std::atof(lost_env) / 100 : Options3d{}.draw_max_volume_error;
+  const char* flat_env = std::getenv("FEBEMESH_SURVEY_FLAT_RETRY");
+  const double flat_retry = flat_env ? std::atof(flat_env) : Options3d{}.flat_retry_below_deg;
   rc::detail::TestParams params = rc::detail::configuration().testParams;
   params.maxSuccess = cases_env ? std::atoi(cases_env) : 20;
   params.disableShrinking = true;
@@ -356,7 +362,7 @@ TEST_CASE("3D pipeline survey of a property family", "[.survey]") {
         double lost = -1.0;
         const auto t0 = std::chrono::steady_clock::now();
         try {
-          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws, draw_below, draw_lost);
+          const Outcome3 out = run_surface(test::to_surface(spec), spec.level, given_axes, lattice_draws, draw_below, draw_lost, flat_retry);
           ++tally.cases;
           how = fallbacks_of(out.r);
           lost = std::abs(out.fe_volume - out.surface_volume) / std::abs(out.surface_volume);

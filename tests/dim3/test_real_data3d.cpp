@@ -65,6 +65,7 @@
 #include "core/validate.hpp"
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
+#include "dim3/planar_frame.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -299,6 +300,38 @@ TEST_CASE("mesh3d data: anchor level 4 (valid without the buffer rule)", "[data]
   CHECK(!d.facing_projection);
   CHECK(d.min_dihedral_deg >= 19.0);
   CHECK(d.volume_rel_error < 0.02);
+}
+
+TEST_CASE("mesh3d data: spool level 5 turned (a face flat just above a lattice plane; the flat buffer's retry)", "[data][pipeline3d][slow]") {
+  // Orientation o22 of experiments/orientations3d.sh: (x, y, z) -> (-z, y, x), exact. An interior
+  // node 0.0012 under one of its flat faces leaves two tetrahedra at 11.75 deg that no node move
+  // mends; without the interior octants whose faces lie flat under the surface (the retry,
+  // Options3d::flat_retry_below_deg) 16.79 deg (session 36).
+  const SurfaceBoundary given = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off");
+  Eigen::Matrix3d turn;
+  turn << 0, 0, -1, 0, 1, 0, 1, 0, 0;
+  SurfaceBoundary s(turned_surface(given.surface(), turn), given.options());
+  Options3d opt;
+  opt.level = 5;
+  Options3d off = opt;
+  off.flat_retry_below_deg = 0.0;
+  const Result3d first = mesh3d(s, off);
+  CHECK_FALSE(first.flat_retry_made);
+  const double first_deg = summarize_quality(first.fe.mesh).min_angle_deg;
+  CHECK(first_deg < 13.0);
+  std::vector<std::string> lines;
+  const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  CHECK(r.flat_retry_made);
+  CHECK(r.flat_retry);
+  CHECK(r.lattice_draw == 0);
+  const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+  INFO(v.summary());
+  CHECK(v.valid);
+  CHECK(summarize_quality(r.fe.mesh).min_angle_deg >= 16.0);
+  const Fidelity3d f = measure_fidelity(r.fe.mesh, s, 1);
+  CHECK(f.volume_rel_error < 0.03);
+  CHECK(f.volume_rel_error <= measure_fidelity(first.fe.mesh, s, 1).volume_rel_error + 0.002);
+  CHECK(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("flat buffer: not degraded") != std::string::npos; }));
 }
 
 TEST_CASE("mesh3d data: anchor level 5 (no tetrahedron under 10 deg)", "[data][pipeline3d][slow]") {
