@@ -26,6 +26,7 @@ options:
   -o, --output DIR   output folder (written atomically; replaced if it exists)
   --level N          febemesh's octree level at the surface (1..9, default 4)
   --extra-levels N   curvature and feature levels above it (0..4, default 2)
+  --target-dihedral DEG  febemesh's optimisation aim (0..35, default 30; as mesh3d's)
   --tolerance F      accepted relative difference of the tet counts (default 0.2)
   --iterations N     at most N TetGen runs to match the count (default 6)
   --quiet            no progress on stderr
@@ -67,7 +68,7 @@ nlohmann::ordered_json metrics_json(const MeshMetrics3d& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--extra-levels", "--tolerance", "--iterations"});
+  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--extra-levels", "--target-dihedral", "--tolerance", "--iterations"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
@@ -76,6 +77,7 @@ int run(const std::vector<std::string>& argv) {
   opt.level = args.int_or("--level", 4, 1, 9);
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.n_threads = 1;
+  set_target_dihedral(opt, args.real_or("--target-dihedral", opt.target_dihedral_deg, 0.0, 35.0));
   CompareOptions3d copt;
   copt.tolerance = args.real_or("--tolerance", 0.2, 0.01, 1.0);
   copt.max_iterations = args.int_or("--iterations", 6, 1, 20);
@@ -88,6 +90,7 @@ int run(const std::vector<std::string>& argv) {
   nlohmann::ordered_json j;
   j["input"] = input;
   j["febemesh"] = metrics_json(c.febemesh);
+  j["febemesh"]["target_dihedral_deg"] = opt.target_dihedral_deg;
   j["tetgen"] = metrics_json(c.tetgen);
   j["tetgen"]["switches"] = c.tetgen_switches;
   nlohmann::ordered_json trials = nlohmann::ordered_json::array();

@@ -137,11 +137,7 @@ int run(const std::vector<std::string>& argv) {
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
-  // One aim for the node sweeps and the edge removal (both 30 deg by default); contraction
-  // stays for the tetrahedra under 15 deg, or under the aim when it is lower.
-  opt.target_dihedral_deg = args.real_or("--target-dihedral", opt.target_dihedral_deg, 0.0, 35.0);
-  opt.remove_edges_below_deg = opt.target_dihedral_deg;
-  opt.contract_edges_below_deg = std::min(opt.contract_edges_below_deg, opt.target_dihedral_deg);
+  dim3::set_target_dihedral(opt, args.real_or("--target-dihedral", opt.target_dihedral_deg, 0.0, 35.0));
   opt.snap_features = !args.has("--no-features");
   // Hidden, for comparisons with the order before session 29: each try once more without
   // feature snapping at once (Options3d::features_fallback_last off).

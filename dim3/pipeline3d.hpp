@@ -7,6 +7,7 @@
 // element), the octants around the place are refined and the construction is redone, up to
 // the maximum level.
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -354,6 +355,15 @@ using Progress3 = std::function<void(const std::string&)>;
 /// then all without (Options3d::features_fallback_last, Result3d::features_dropped); when those
 /// are refused cheaply, all of it one level finer (Options3d::raise_levels).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
+
+/// The optimisation's aim (the CLI's --target-dihedral): the node sweeps' target_dihedral_deg and
+/// the edge removal's bar; contraction stays for the tetrahedra under 15 deg, or under the aim
+/// when that is lower.
+inline void set_target_dihedral(Options3d& opt, double deg) {
+  opt.target_dihedral_deg = deg;
+  opt.remove_edges_below_deg = deg;
+  opt.contract_edges_below_deg = std::min(Options3d{}.contract_edges_below_deg, deg);
+}
 
 /// The root cube's shift of lattice draw k (1, 2; Options3d::lattice_draws), in shares of its
 /// side (SurfaceOptions::root_shift); zero for k = 0.

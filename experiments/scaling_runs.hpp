@@ -152,9 +152,7 @@ inline OurRun run_ours_3d(const std::string& path, int level, int threads, const
     dim3::Options3d opt;
     opt.level = level;
     opt.n_threads = threads;
-    opt.target_dihedral_deg = target_dihedral_deg;
-    opt.remove_edges_below_deg = target_dihedral_deg;
-    opt.contract_edges_below_deg = std::min(opt.contract_edges_below_deg, target_dihedral_deg);
+    dim3::set_target_dihedral(opt, target_dihedral_deg);
     dim3::Result3d r = dim3::mesh3d(s, opt);
     if (r.quality) min_deg = r.quality->min_angle_deg;  // mesh3d's summary, ranking the run
     return std::pair{std::move(r.fe.mesh), std::move(r.times)};

@@ -67,6 +67,7 @@ TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both to
   // Our octree mesh has no slivers here (measured 28.0 deg smallest dihedral at level 4).
   CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() >= 20.0);
   CHECK(j["febemesh"]["slivers_below_10deg"].get<int>() == 0);
+  CHECK(j["febemesh"]["target_dihedral_deg"].get<double>() == 30.0);  // mesh3d's default aim
   for (const char* f : {"comparison.md", "min-dihedral.svg", "max-dihedral.svg", "radius-ratio.svg",
                         "scaled-jacobian.svg", "mesh.msh", "tetgen.msh", "tetgen.log"})
     CHECK(std::filesystem::exists(out / f));
@@ -77,8 +78,13 @@ TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both to
 TEST_CASE("compare3d warns when TetGen cannot come down to our tet count", "[cli][compare]") {
   // At level 3 we make ~2,800 tets; TetGen's smallest mesh of the 966 input triangles is ~4x more.
   const auto out = tmp_dir() / "coarse";
-  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --quiet") == 0);
+  // (With a lower optimisation aim, passed on to mesh3d: --target-dihedral.)
+  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --target-dihedral 20 --quiet") == 0);
   const auto j = read_json(out / "comparison.json");
+  CHECK(j["febemesh"]["target_dihedral_deg"].get<double>() == 20.0);
+  CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() >= 15.0);
+  CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() < 25.0);  // (30.00 at the default aim)
+  CHECK(run_status("compare3d '" + sphere() + "' -o '" + (out / "x").string() + "' --target-dihedral 40 --quiet") == 2);
   CHECK(j["element_count_ratio"].get<double>() > 1.2);
   CHECK(j["element_count_within_tolerance"] == false);
   CHECK(read_text(out / "comparison.md").find("**Warning:** tetgen's element count is") != std::string::npos);
