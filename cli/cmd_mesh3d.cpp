@@ -14,6 +14,7 @@
 
 #include "cli/args.hpp"
 #include "cli/command.hpp"
+#include "cli/limit_hint.hpp"
 #include "cli/progress.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
@@ -24,7 +25,6 @@
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_boundary.hpp"
-#include "cli/limit_hint.hpp"
 
 namespace febemesh::cli {
 namespace {

@@ -273,9 +273,8 @@ struct Options3d {
   /// Where the mesh that stands is valid and its smallest dihedral angle is under this
   /// (degrees; 0: never), one more run on its lattice with flat_buffer at flat_retry_buffer
   /// (within the octants it built, no level raise, no thin-part retry, no mesh after a
-  /// refusal); that mesh stands if it ranks no worse, loses no
-  /// more than draw_max_volume_error or the first's volume, and its smallest angle is larger. A
-  /// flat face a little above a lattice plane leaves interior octants whose free faces lie on it,
+  /// refusal); that mesh stands if it ranks no worse, loses no more than draw_max_volume_error
+  /// or the first's volume, and its smallest angle is larger. A flat face a little above a lattice plane leaves interior octants whose free faces lie on it,
   /// flat boundary octants whose slivers no node move mends (spool L5 o22: an interior node
   /// 0.0012 under a face, two tetrahedra at 11.75 deg; 16.79 with the flat buffer). On every try
   /// the flat buffer costs thin parts and time (docs/measurements.md, session 36), so it is a

@@ -239,6 +239,7 @@ inline BaselineRun run_tetgen_matched(const std::string& path, std::size_t targe
   double bound = 2.0 * std::abs(volume) / double(target);
   BaselineRun best;
   const fs::path out = dir / "tetgen.msh";
+  Mesh<3> last;  // the last trial's mesh (the one returned), measured once after the loop
   for (int t = 0; t < max_trials; ++t) {
     std::ostringstream sw;
     sw.precision(6);
@@ -257,17 +258,15 @@ inline BaselineRun run_tetgen_matched(const std::string& path, std::size_t targe
     b.wall_seconds = c.wall_seconds;
     b.cpu_seconds = children_cpu_seconds() - cpu0;
     b.peak_bytes = c.peak_memory_growth_bytes;
-    if (c.ok) {
-      const Mesh<3> m = read_msh<3>(out);
-      b.elements = m.solid.size();
-      b.min_dihedral_deg = summarize_quality<3>(m, 10.0).min_angle_deg;
-    }
+    last = c.ok ? read_msh<3>(out) : Mesh<3>{};
+    b.elements = last.solid.size();
     best = b;
     if (!b.ok || b.elements == 0) break;
     const double n = double(b.elements);
     if (std::abs(n - double(target)) <= tolerance * double(target)) break;
     bound *= n / double(target);
   }
+  if (best.ok && best.elements > 0) best.min_dihedral_deg = summarize_quality<3>(last, 10.0).min_angle_deg;
   return best;
 }
 
