@@ -1,11 +1,10 @@
 // bench_mesh2d: febemesh against Gmsh, end to end, at the same element count (issue 8).
 //
 // For every input (the bundled parts and a few glyphs) and every target size, a level is chosen
-// so that the mesh lands near the target: two cheap calibration runs (levels 6 and 7) fit
-// n = a 2^(b L), and the level for the target is read off that fit. The run is then timed from
-// the parsed input to a written mesh.msh (experiments/scaling_runs.hpp); Gmsh meshes the same
-// exact curves (dim2/compare_gmsh's .geo) with a uniform size rescaled until its triangle count
-// is within 20% of ours. The table gives both speeds, both memories per element and the ratio.
+// so that the mesh lands near the target: untimed runs search for the level whose count is within
+// 10% of it (aim_level). The run is then timed from the parsed input to a written mesh.msh
+// (experiments/scaling_runs.hpp); Gmsh meshes the same exact curves (dim2/compare_gmsh's .geo)
+// with a uniform size rescaled until its triangle count is within 20% of ours. The table gives both speeds, both memories per element and the ratio.
 //
 // Usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a.json,b.svg] [--no-gmsh] [--threads N]
 //                     [--memory-budget GB] [--gmsh-max N]
@@ -14,13 +13,15 @@
 //   it is skipped with a message (default 6 GB: the machine is shared).
 //   --gmsh-max: no Gmsh run above this many elements (default 1.2e6; Gmsh takes ~30 s per 10^6).
 //   --elements: tri (default), quad or mixed.
-//   --levels: run these levels instead of fitting levels to --sizes (the element count is a step
-//   function of the level on some inputs, e.g. the flange jumps from 85k at 8 to 340k at 8.23,
-//   so the fit can miss its target by 3x; then name the levels).
+//   --levels: run these levels instead of searching levels for --sizes (the element count is a
+//   step function of the level on some inputs, e.g. the flange jumps from 85k at 8 to 340k at
+//   8.23, so the search may end further than 10% from its target; it takes the nearest count).
 // Output: tables on stdout, results/bench_mesh2d.md and results/bench_mesh2d.json.
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -41,27 +42,82 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-struct Fit {
-  double a = 0.0, b = 1.0;  ///< n = a 2^(b L)
-  double level_for(double n) const { return std::log2(n / a) / b; }
+/// The element count of mesh2d at `level` (-1 where the tree would pass its size limit).
+double count_at(const dim2::CurveBoundary& base, double level, dim2::ElementKind elements, int threads) {
+  dim2::CurveBoundary curve = base;
+  curve.set_global_level(level);
+  dim2::Options2d opt;
+  opt.level = level;
+  opt.keep_stages = false;
+  opt.n_threads = threads;
+  opt.elements = elements;
+  try {
+    return double(dim2::mesh2d(curve, opt).fe.mesh.solid.size());
+  } catch (const LimitError&) {
+    return -1.0;
+  }
+}
+
+struct Aim {
+  double level = 0.0;
+  double count = 0.0;  ///< at `level`, from the search's own run
+  int runs = 0;        ///< untimed runs the search made
 };
 
-/// Two cheap runs at levels 6 and 7 (element counts only); below, file levels and the thickness
-/// rule dominate and the growth is not yet geometric.
-Fit calibrate(const dim2::CurveBoundary& base) {
-  double n[2];
-  for (int k = 0; k < 2; ++k) {
-    dim2::CurveBoundary curve = base;
-    curve.set_global_level(6.0 + k);
-    dim2::Options2d opt;
-    opt.level = 6.0 + k;
-    opt.keep_stages = false;
-    n[k] = double(dim2::mesh2d(curve, opt).fe.mesh.solid.size());
+/// The level (to 0.01) whose element count is nearest `target`, within 10% where the count's
+/// step function allows. Untimed runs: levels 6 and 7, then a search that keeps a bracket in
+/// log(count) against level, reading the next level off the line through the two nearest
+/// points and stepping at most 1.5 levels past the highest run below the target (a fit of
+/// levels 6 and 7 alone put flange's 10^6 at level 10.16, 5.4 x 10^6 elements; bracket's and
+/// naca0012's past the tree's size limit).
+Aim aim_level(const dim2::CurveBoundary& base, double target, dim2::ElementKind elements, int threads) {
+  struct Point {
+    double level, count;
+  };
+  std::vector<Point> runs;
+  const auto run = [&](double level) {
+    runs.push_back({level, count_at(base, level, elements, threads)});
+    return runs.back();
+  };
+  run(6.0);
+  run(7.0);
+  const auto best = [&] {
+    Aim a;
+    double miss = std::numeric_limits<double>::infinity();
+    for (const Point& p : runs)
+      if (p.count > 0 && std::abs(std::log(p.count / target)) < miss) miss = std::abs(std::log(p.count / target)), a.level = p.level, a.count = p.count;
+    a.runs = int(runs.size());
+    return a;
+  };
+  for (int iter = 0; iter < 10; ++iter) {
+    const Aim now = best();
+    if (now.count > 0 && std::abs(now.count / target - 1.0) <= 0.1) return now;
+    // The bracket: the highest level below the target and the lowest above (or refused).
+    double lo = -1.0, lo_n = 0.0, hi = 1e9, hi_n = 0.0;
+    for (const Point& p : runs) {
+      if (p.count > 0 && p.count < target && p.level > lo) lo = p.level, lo_n = p.count;
+      if ((p.count < 0 || p.count > target) && p.level < hi) hi = p.level, hi_n = p.count;
+    }
+    double next;
+    if (hi > 1e8) {  // nothing above yet: extrapolate from the two highest levels below
+      double lo2 = -1.0, lo2_n = 0.0;
+      for (const Point& p : runs)
+        if (p.count > 0 && p.level < lo && p.level > lo2) lo2 = p.level, lo2_n = p.count;
+      const double slope = std::clamp(std::log2(lo_n / lo2_n) / (lo - lo2), 0.5, 2.5);  // log2(count) per level
+      next = std::min(lo + std::log2(target / lo_n) / slope, lo + 1.5);
+    } else if (lo < 0) {  // nothing below: halve the way down
+      next = hi - 1.0;
+    } else if (hi_n > 0) {  // between: the line through the bracket in log(count)
+      next = lo + (hi - lo) * std::log(target / lo_n) / std::log(hi_n / lo_n);
+      next = std::clamp(next, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
+    } else {
+      next = 0.5 * (lo + hi);
+    }
+    next = std::round(next * 100.0) / 100.0;
+    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return p.level == next; })) break;
+    run(next);
   }
-  Fit f;
-  f.b = std::clamp(std::log2(n[1] / n[0]), 0.9, 2.0);
-  f.a = n[0] / std::exp2(f.b * 6.0);
-  return f;
+  return best();
 }
 
 }  // namespace
@@ -125,10 +181,8 @@ int main(int argc, char** argv) {
     const std::string name = fs::path(input).stem().string();
     std::cout << "== " << name << "\n" << std::flush;
     std::optional<dim2::CurveBoundary> base;
-    Fit fit;
     try {
       base.emplace(dim2::read_domain(input));
-      fit = calibrate(*base);
     } catch (const std::exception& e) {
       std::cout << "  skipped: " << e.what() << "\n";
       skipped << "- " << name << ": " << e.what() << "\n";
@@ -137,9 +191,12 @@ int main(int argc, char** argv) {
     double bytes_per_el = 0.0;
     const std::vector<double>& runs = levels.empty() ? sizes : levels;
     for (const double size_or_level : runs) {
-      const double target = levels.empty() ? size_or_level : fit.a * std::exp2(fit.b * size_or_level);
-      const std::string tag = name + " " + sci(target, 2);
-      if (bytes_per_el > 0 && bytes_per_el * target > budget) {
+      // --sizes: the target; --levels: no target (the budget check then uses the level's count
+      // as the run before it, scaled by 4 per level).
+      const bool sized = levels.empty();
+      const double target = sized ? size_or_level : 0.0;
+      const std::string tag = name + " " + (sized ? sci(target, 2) : "level " + fixed(size_or_level, 2));
+      if (sized && bytes_per_el > 0 && bytes_per_el * target > budget) {
         std::ostringstream msg;
         msg << tag << ": skipped, estimated peak " << sci(bytes_per_el * target / 1e9) << " GB > budget "
             << sci(budget / 1e9) << " GB (--memory-budget)";
@@ -148,7 +205,14 @@ int main(int argc, char** argv) {
         continue;
       }
       // Levels are real: the control level interpolates the cell size between powers of two.
-      const double level = levels.empty() ? std::round(fit.level_for(target) * 100.0) / 100.0 : size_or_level;
+      double level = size_or_level;
+      if (sized) {
+        const Aim aim = aim_level(*base, target, elements, threads);
+        level = aim.level;
+        std::cout << "  " << tag << ": level " << level << " (" << aim.runs << " untimed runs; " << std::int64_t(aim.count)
+                  << " elements)\n"
+                  << std::flush;
+      }
       const OurRun run = run_ours_2d(*base, level, threads, work / name, elements);
       if (!run.ok) {
         std::cout << "  " << tag << ": febemesh failed: " << run.error << "\n";
@@ -161,7 +225,7 @@ int main(int argc, char** argv) {
       const double ratio = g.ok ? run.elements_per_second() / g.elements_per_second() : 0.0;
       const double cpu_ratio = g.ok ? (double(run.elements) / run.cpu_seconds) / g.elements_per_cpu_second() : 0.0;
       std::ostringstream row;
-      row << "| " << name << " | " << sci(target, 2) << " | " << level << " | " << run.elements << " | "
+      row << "| " << name << " | " << (sized ? sci(target, 2) : "-") << " | " << level << " | " << run.elements << " | "
           << fixed(run.wall_seconds) << " | " << fixed(run.cpu_seconds) << " | " << sci(run.elements_per_second())
           << " | " << sci(double(run.elements) / run.cpu_seconds) << " | " << fixed(run.peak_bytes / 1e6, 1) << " | "
           << fixed(run.bytes_per_element(), 0) << " | ";
@@ -177,7 +241,7 @@ int main(int argc, char** argv) {
 
       nlohmann::json j;
       j["input"] = name;
-      j["target"] = target;
+      if (sized) j["target"] = target;
       j["level"] = level;
       j["threads"] = threads;
       j.update(run_json(run));
