@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <future>
 #include <iostream>
@@ -29,6 +30,13 @@
 namespace febemesh::cli {
 namespace {
 
+/// x as printf's %g (6 significant digits).
+std::string fmt_g(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", x);
+  return text;
+}
+
 const char* help_text =
     "usage: febemesh mesh3d SURFACE -o DIR [options]\n\n"
     "Tetrahedral (or hex-dominant) FE mesh of the solid bounded by a closed triangle surface\n"
@@ -40,6 +48,10 @@ const char* help_text =
     "options:\n"
     "  -o DIR              output folder (mesh.msh, mesh.vtu, report.json), written atomically\n"
     "  --level N           global octree level at the surface (1..9, default 4)\n"
+    "  --size H            instead of --level: the octants' side at the surface, in the\n"
+    "                      surface's units (the level whose octants are no larger, in a\n"
+    "                      root cube enlarged by less than 2x so that they are H; the\n"
+    "                      element count then follows H instead of 8x steps)\n"
     "  --extra-levels N    extra levels for curvature and features (0..4, default 2)\n"
     "  --elements KIND     tet (default), or hex: hex-dominant (hexahedra where the octants\n"
     "                      conform, pyramids and tetrahedra elsewhere; quad BE faces where\n"
@@ -125,7 +137,7 @@ int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
-                  {"-o", "--level", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
+                  {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
                    "--flat-buffer", "--flat-retry-below"});
   args.expect_positional({"SURFACE"});
@@ -134,6 +146,10 @@ int run(const std::vector<std::string>& argv) {
   if (!out) throw UsageError("missing -o DIR");
   dim3::Options3d opt;
   opt.level = args.int_or("--level", 4, 1, 9);
+  if (args.has("--size")) {
+    if (args.has("--level")) throw UsageError("--size and --level: give one of them");
+    opt.size = args.real_or("--size", 0.0, 1e-300, 1e300);
+  }
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
@@ -170,6 +186,17 @@ int run(const std::vector<std::string>& argv) {
   const auto t0 = std::chrono::steady_clock::now();
   progress("reading " + input);
   dim3::SurfaceBoundary surface = dim3::SurfaceBoundary::from_file(input);
+  if (opt.size > 0) {
+    // --level's range for the level --size gives in the given axes (a frame's may differ).
+    const dim3::SizedLevel sl = dim3::level_for_size(surface.bounding_box(), opt.size);
+    const double side = surface.root_box().extent()[0];
+    if (sl.level > 9) {
+      std::ostringstream os;
+      os << "--size " << opt.size << " on " << input << " (root cube " << side << " across) needs level " << sl.level
+         << "; the finest is 9, octants of " << side / 512 << " or more";
+      throw UsageError(os.str());
+    }
+  }
   const double t_read = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   dim3::Result3d r;
@@ -218,7 +245,9 @@ int run(const std::vector<std::string>& argv) {
 
   nlohmann::json rep;
   rep["input"] = input;
-  rep["options"] = {{"level", opt.level},
+  rep["options"] = {{"level", r.level},
+                    {"size", opt.size > 0 ? nlohmann::json(opt.size) : nlohmann::json(nullptr)},
+                    {"root_scale", r.root_scale},
                     {"extra_levels", opt.extra_levels},
                     {"elements", elements},
                     {"buffer", opt.buffer},
@@ -368,9 +397,10 @@ int run(const std::vector<std::string>& argv) {
     std::cerr << "febemesh mesh3d: warning: " << w.str() << "\n";
   }
   if (r.level_raised > 0) {
-    const std::string w = input + ": refused at --level " + std::to_string(opt.level) + "; meshed at level " +
-                          std::to_string(opt.level + r.level_raised) + " (the shape's features are too small for level " +
-                          std::to_string(opt.level) + ")";
+    const std::string w = input + ": refused at " + (opt.size > 0 ? "level " : "--level ") + std::to_string(r.level) +
+                          (opt.size > 0 ? " (--size " + fmt_g(opt.size) + ")" : std::string()) + "; meshed at level " +
+                          std::to_string(r.level + r.level_raised) + " (the shape's features are too small for level " +
+                          std::to_string(r.level) + ")";
     warnings.push_back(w);
     std::cerr << "febemesh mesh3d: warning: " << w << "\n";
   }

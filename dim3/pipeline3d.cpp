@@ -459,7 +459,41 @@ P3 lattice_draw_shift(int k) {
   return P3::Zero();
 }
 
-Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress) {
+SizedLevel level_for_size(const Box<3>& bounding_box, double size) {
+  const double side = 1.05 * bounding_box.extent().maxCoeff();  // SurfaceBoundary::root_box at scale 1
+  SizedLevel sl;
+  sl.level = std::max(1, static_cast<int>(std::ceil(std::log2(side / size))));
+  sl.root_scale = size * std::ldexp(1.0, sl.level) / side;
+  // A size that is the default cube's octant of some level, to rounding, is that level in the
+  // default cube (the same mesh as --level), not the next one in a cube twice as large.
+  if (std::abs(sl.root_scale - 1.0) < 1e-12) {
+    sl.root_scale = 1.0;
+  } else if (sl.root_scale < 1.0) {  // log2's rounding below a power of two
+    sl.level += 1;
+    sl.root_scale *= 2.0;
+  }
+  return sl;
+}
+
+Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& progress) {
+  // Options3d::size: each surface meshed (the given one, the one turned into its frame, whose
+  // bounding box differs) at its own level and root scale.
+  const auto sized = [&](SurfaceBoundary& on, const char* where) {
+    Options3d o = opt_in;
+    if (opt_in.size > 0) {
+      const SizedLevel sl = level_for_size(on.bounding_box(), opt_in.size);
+      on.set_root_scale(sl.root_scale);
+      o.level = sl.level;
+      if (progress) {
+        char text[160];
+        std::snprintf(text, sizeof text, "size %g%s: level %d in a root cube %.4gx the default (%g across)", opt_in.size,
+                      where, sl.level, sl.root_scale, on.root_box().extent()[0]);
+        progress(text);
+      }
+    }
+    return o;
+  };
+  const Options3d opt = sized(s, "");
   PlanarFrame frame = planar_frame(s.surface());
   const bool turn = opt.align_planar_faces && frame.turned;
   std::optional<SurfaceBoundary> turned;
@@ -474,6 +508,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     }
     turned.emplace(turned_surface(s.surface(), frame.to_frame), s.options());
   }
+  const Options3d opt_frame = turn ? sized(*turned, " in the frame") : opt;
   // The runs in order: (in the frame?, draw). Each stands when it is not degraded; the draws
   // of one axes share its work bound.
   struct Plan {
@@ -553,9 +588,11 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
       else
         progress("in the frame of the planar faces: " + what + "; once more in the given axes");
     }
-    runs.push_back(run_drawn(on, opt, p.draw, limit, origin, progress));
+    const Options3d& o = p.in_frame ? opt_frame : opt;
+    runs.push_back(run_drawn(on, o, p.draw, limit, origin, progress));
     Drawn& d = runs.back();
     d.in_frame = p.in_frame;
+    if (d.r) d.r->level = o.level, d.r->root_scale = on.root_scale();
     in_given_axes(d);
     // Of the runs so far: the lowest rank, then the least volume lost, then the first.
     if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
@@ -583,7 +620,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
     return std::move(*b.r);
 
   // Options3d::flat_retry_below_deg: once more on the same lattice with the flat buffer.
-  Options3d f = opt;
+  Options3d f = b.in_frame ? opt_frame : opt;
   f.flat_buffer = opt.flat_retry_buffer;
   f.raise_levels = 0;  // (degraded anyway)
   // No retry for thin parts inside it: where the flat buffer leaves a thin part without
@@ -602,6 +639,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progr
   Drawn retry = run_drawn(b.in_frame ? *turned : s, f, b.draw, limit, "the octants of the run it retries", progress, true);
   retry.in_frame = b.in_frame;
   in_given_axes(retry);
+  if (retry.r) retry.r->level = f.level, retry.r->root_scale = (b.in_frame ? *turned : s).root_scale();
   const bool better = retry.r && (retry.rank < b.rank || (retry.rank == b.rank && retry.min_deg > b.min_deg &&
                                                           retry.error <= std::max(b.error, opt.draw_max_volume_error)));
   if (progress) {

@@ -27,6 +27,11 @@ namespace febemesh::dim3 {
 
 struct Options3d {
   int level = 4;                     ///< global level at the surface
+  /// The octants' side at the surface in the surface's units (0: by `level`). mesh3d then meshes
+  /// at the level whose octants in the default root cube are no larger (level_for_size) and
+  /// enlarges the root cube by less than 2x (SurfaceOptions::root_scale) so that they have this
+  /// side; the curvature, feature and thickness levels follow the root cube.
+  double size = 0.0;
   int extra_levels = 2;              ///< curvature/feature refinement above `level`
   int smoothing_iterations = 4;      ///< the paper recommends about four
   double buffer = 0.2;               ///< drop interior octants nearer the surface than this x size
@@ -311,7 +316,9 @@ struct Result3d {
   bool thickness_after_refusal = false;  ///< refused; this run has Options3d::refused_thickness_cells' thickness level
   bool thin_parts_coarse = false;    ///< refused; this run has Options3d::coarse_thin_after_refusal's rules
   bool thickness_early = false;      ///< the first tree had problems; this run is Options3d::thickness_probe's tree
-  int level_raised = 0;              ///< refused at Options3d::level; meshed this many levels finer (raise_levels)
+  int level = 0;                     ///< the level asked for: Options3d::level, or the one Options3d::size gave
+  double root_scale = 1.0;           ///< SurfaceOptions::root_scale of the run (Options3d::size)
+  int level_raised = 0;              ///< refused at the level asked; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;
   std::size_t n_untangle_moves = 0;  ///< node moves of the untangling (tet_optimize)
@@ -363,6 +370,15 @@ inline void set_target_dihedral(Options3d& opt, double deg) {
   opt.remove_edges_below_deg = deg;
   opt.contract_edges_below_deg = std::min(Options3d{}.contract_edges_below_deg, deg);
 }
+
+/// Options3d::size on a surface with this bounding box: the level whose octants in the default
+/// root cube (1.05 x the largest extent) are no larger than `size`, at least 1, and the root
+/// scale (in [1, 2) unless `size` needs a level under 1) that makes that level's octants `size`.
+struct SizedLevel {
+  int level = 1;
+  double root_scale = 1.0;
+};
+SizedLevel level_for_size(const Box<3>& bounding_box, double size);
 
 /// The root cube's shift of lattice draw k (1, 2; Options3d::lattice_draws), in shares of its
 /// side (SurfaceOptions::root_shift); zero for k = 0.

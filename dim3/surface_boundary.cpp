@@ -27,9 +27,8 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
       tree_(surface_.vertices(), surface_.triangles()),
       features_(surface_, options.features) {
   diagonal_ = surface_.bounding_box().extent().norm();
-  const double root_side = root_box().extent()[0];
   const int nt = surface_.n_triangles();
-  curvature_level_.assign(nt, -std::numeric_limits<double>::infinity());
+  curvature_.assign(nt, 0.0);
   near_feature_.assign(nt, false);
   std::vector<P3> centroid(nt);
   for (std::int32_t t = 0; t < nt; ++t) {
@@ -58,13 +57,22 @@ SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
       if (kappa_count[v] > 0) kappa += kappa_sum[v] / kappa_count[v] / 3.0;
       if (features_.is_feature_edge(surface_.triangle_edge(t, i)) || features_.is_corner(v)) near_feature_[t] = true;
     }
-    if (kappa > 0.0) curvature_level_[t] = std::log2(root_side * kappa / options_.arc);
+    curvature_[t] = kappa;
   }
+  set_root_scale(options_.root_scale);
+}
+
+void SurfaceBoundary::set_root_scale(double scale) {
+  options_.root_scale = scale;
+  root_side_ = root_box().extent()[0];
+  const std::size_t nt = curvature_.size();
+  curvature_level_.assign(nt, -std::numeric_limits<double>::infinity());
+  for (std::size_t t = 0; t < nt; ++t)
+    if (const double kappa = curvature_[t]; kappa > 0.0) curvature_level_[t] = std::log2(root_side_ * kappa / options_.arc);
   // Thickness: the first surface point hit by a ray from the centroid straight inwards. A part
   // thinner than a few octants has no interior octant across it and falls apart (measured: rotor
   // and elephant at level 4 changed topology), so the level field asks for `thickness_cells`
   // octants across it.
-  root_side_ = root_side;
   set_thickness_level(options_.thickness_cells, options_.thickness_max_level);
 }
 
@@ -182,7 +190,7 @@ SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptio
 
 Box<3> SurfaceBoundary::root_box() const {
   const Box<3> b = surface_.bounding_box();
-  const double half = 0.5 * 1.05 * b.extent().maxCoeff();
+  const double half = 0.5 * 1.05 * b.extent().maxCoeff() * options_.root_scale;
   Box<3> cube;
   cube.lo = b.center().array() - half + 2.0 * half * options_.root_shift.array();
   cube.hi = b.center().array() + half + 2.0 * half * options_.root_shift.array();

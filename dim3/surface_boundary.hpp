@@ -56,6 +56,9 @@ struct SurfaceOptions {
   /// it makes flat boundary octants on it (rotor.off's rim, 0.05 of a level-8 octant above
   /// one); a shift moves every lattice plane against the surface.
   P3 root_shift = P3::Zero();
+  /// The root cube's side over its default (1.05 x the bounding box's largest extent), >= 1:
+  /// Options3d::size sets it so that the octants of its level have that side.
+  double root_scale = 1.0;
 };
 
 class SurfaceBoundary final : public Boundary<3> {
@@ -93,9 +96,12 @@ class SurfaceBoundary final : public Boundary<3> {
   const AabbTree& tree() const { return tree_; }
   /// The options as they are now (the levels set since construction included).
   const SurfaceOptions& options() const { return options_; }
-  /// Smallest cube around the bounding box, enlarged by 5%, same centre, shifted by
-  /// SurfaceOptions::root_shift.
+  /// Smallest cube around the bounding box, enlarged by 5% and by SurfaceOptions::root_scale,
+  /// same centre, shifted by SurfaceOptions::root_shift.
   Box<3> root_box() const;
+  /// SurfaceOptions::root_scale (>= 1); the curvature and thickness levels follow the new side.
+  void set_root_scale(double scale);
+  double root_scale() const { return options_.root_scale; }
   /// SurfaceOptions::root_shift; the trees built after it use the moved lattice.
   void set_root_shift(const P3& shift) { options_.root_shift = shift; }
   const P3& root_shift() const { return options_.root_shift; }
@@ -150,6 +156,7 @@ class SurfaceBoundary final : public Boundary<3> {
   SurfaceOptions options_;
   AabbTree tree_;
   Features features_;
+  std::vector<double> curvature_;        ///< per triangle: the curvature behind its level (0: flat)
   std::vector<double> curvature_level_;
   std::vector<double> thickness_;        ///< thickness(t), when computed
   std::vector<double> centroid_thickness_;  ///< centroid_thickness(t), when computed

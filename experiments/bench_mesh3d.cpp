@@ -4,10 +4,12 @@
 // mesh.msh (experiments/scaling_runs.hpp: stage times, peak RSS growth); TetGen (libtet,
 // -pq1.414/10 with a volume bound rescaled until its tet count is within 20% of ours) runs in
 // a forked child from reading the .off to writing tetgen.msh (dim3/compare_tetgen). 3D levels
-// are integers, so the sizes step by about 4-8x per level.
+// are integers, so the sizes step by about 4-8x per level; --tets names tet counts instead, and
+// untimed runs search the octant size (mesh3d's --size, Options3d::size) that gives each within
+// 10% (aim_size).
 //
-// Usage: bench_mesh3d [--levels 3,4,5] [--inputs a.off,b.off | --all-surfaces] [--no-tetgen]
-//                     [--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]
+// Usage: bench_mesh3d [--levels 3,4,5 | --tets 1e4,1e5,1e6,5e6] [--inputs a.off,b.off | --all-surfaces]
+//                     [--no-tetgen] [--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]
 // --target-dihedral: the CLI's option of that name (the optimisation's aim, default 30). Both
 // tools' smallest dihedral angles are in the table (measured after the timed runs).
 // The default input is sphere966 (no repairs: the stages' own speed); --all-surfaces takes every
@@ -21,6 +23,7 @@
 // Output: tables on stdout, results/bench_mesh3d.md and results/bench_mesh3d.json.
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -49,11 +52,65 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
+/// The octant size (Options3d::size) whose tet count is within 10% of `target`, by untimed runs
+/// of mesh3d (at most 8): the first at the default cube's level-4 octant, then along a line in
+/// log(count) against log(size) through the two runs nearest the target (the count grows as
+/// size^-2 to size^-3: the surface's octants, then the volume's); the nearest run's size.
+struct Aim {
+  double size = 0.0;
+  std::size_t count = 0;
+  int runs = 0;
+};
+Aim aim_size(const std::string& path, double target, int threads, double target_deg) {
+  struct Point {
+    double size, count;
+  };
+  std::vector<Point> runs;
+  dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
+  const auto count_at = [&](double size) {
+    dim3::Options3d opt;
+    opt.size = size;
+    opt.n_threads = threads;
+    dim3::set_target_dihedral(opt, target_deg);
+    double n = 0.0;
+    try {
+      n = double(dim3::mesh3d(s, opt).fe.mesh.solid.size());
+    } catch (const std::exception&) {
+      n = 0.0;  // refused: no count (a size too small for the tree's limit is the usual one)
+    }
+    runs.push_back({size, n});
+    return n;
+  };
+  const auto miss = [&](const Point& p) { return p.count > 0 ? std::abs(std::log(p.count / target)) : 1e300; };
+  double size = s.root_box().extent()[0] / 16.0;
+  for (int k = 0; k < 8; ++k) {
+    const double n = count_at(size);
+    if (n > 0 && std::abs(n / target - 1.0) <= 0.1) break;
+    std::vector<Point> ok;
+    for (const Point& p : runs)
+      if (p.count > 0) ok.push_back(p);
+    if (ok.empty()) {
+      size *= 2.0;  // refused: coarser
+      continue;
+    }
+    std::sort(ok.begin(), ok.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
+    double slope = -2.5;  // d log(count) / d log(size)
+    if (ok.size() >= 2 && ok[0].size != ok[1].size && ok[0].count != ok[1].count)
+      slope = std::clamp(std::log(ok[0].count / ok[1].count) / std::log(ok[0].size / ok[1].size), -3.5, -1.5);
+    const double next = ok[0].size * std::pow(target / ok[0].count, 1.0 / slope);
+    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return std::abs(p.size / next - 1.0) < 1e-6; })) break;
+    size = next;
+  }
+  const auto best = std::min_element(runs.begin(), runs.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
+  return {best->size, static_cast<std::size_t>(best->count), static_cast<int>(runs.size())};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   febemesh::set_up_heap(argv);  // first: it may start the program again
   std::vector<int> levels{3, 4, 5};
+  std::vector<double> tets;  // --tets: counts instead of levels
   const std::string data = FEBEMESH_DATA_DIR, src = FEBEMESH_SOURCE_DIR;
   std::vector<std::string> inputs{data + "/3d/sphere966.off"};
   bool tetgen = true;
@@ -73,6 +130,8 @@ int main(int argc, char** argv) {
     if (a == "--levels") {
       levels.clear();
       for (const auto& s : split(next())) levels.push_back(std::stoi(s));
+    } else if (a == "--tets") {
+      for (const auto& s : split(next())) tets.push_back(std::stod(s));
     } else if (a == "--inputs") {
       inputs = split(next());
     } else if (a == "--all-surfaces") {
@@ -93,7 +152,7 @@ int main(int argc, char** argv) {
     } else if (a == "--target-dihedral") {
       target_deg = std::clamp(std::stod(next()), 0.0, 35.0);
     } else {
-      std::cerr << "usage: bench_mesh3d [--levels 3,4,5] [--inputs a.off,b.off | --all-surfaces] [--no-tetgen] "
+      std::cerr << "usage: bench_mesh3d [--levels 3,4,5 | --tets 1e4,1e5] [--inputs a.off,b.off | --all-surfaces] [--no-tetgen] "
                    "[--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]\n";
       return 2;
     }
@@ -128,39 +187,56 @@ int main(int argc, char** argv) {
     }
     std::size_t previous = 0;
     double bytes_per_el = 0.0;
-    for (const int level : levels) {
-      const std::string tag = name + " L" + std::to_string(level);
-      // The next level has up to 8x the tets of this one.
-      if (bytes_per_el > 0 && bytes_per_el * 8.0 * double(previous) > budget) {
+    // Levels, or with --tets target counts (level 0 until the search gives a size).
+    std::vector<std::pair<int, double>> specs;
+    for (const int level : levels)
+      if (tets.empty()) specs.emplace_back(level, 0.0);
+    for (const double n : tets) specs.emplace_back(0, n);
+    for (const auto& [level_asked, target] : specs) {
+      int level = level_asked;
+      std::string tag = name + (target > 0 ? " " + sci(target, 2) + " tets" : " L" + std::to_string(level));
+      // The next level has up to 8x the tets of this one; a target, its own count.
+      const double expected = target > 0 ? target : 8.0 * double(previous);
+      if (bytes_per_el > 0 && bytes_per_el * expected > budget) {
         std::ostringstream msg;
-        msg << tag << ": skipped, estimated peak up to " << sci(bytes_per_el * 8.0 * double(previous) / 1e9)
-            << " GB > budget " << sci(budget / 1e9) << " GB (--memory-budget)";
+        msg << tag << ": skipped, estimated peak up to " << sci(bytes_per_el * expected / 1e9) << " GB > budget "
+            << sci(budget / 1e9) << " GB (--memory-budget)";
         std::cout << "  " << msg.str() << "\n";
         skipped << "- " << msg.str() << "\n";
         continue;
+      }
+      double size = 0.0;
+      if (target > 0) {
+        const Aim aim = aim_size(input, target, threads, target_deg);
+        size = aim.size;
+        std::cout << "  " << tag << ": size " << aim.size << " (" << aim.runs << " untimed runs; " << aim.count << " tets)\n"
+                  << std::flush;
       }
       // Each thread count's fastest of `repeat` runs, the counts taking turns.
       std::vector<OurRun> best(thread_counts.size());
       for (int r = 0; r < repeat; ++r)
         for (std::size_t k = 0; k < thread_counts.size(); ++k) {
           const fs::path dir = thread_counts.size() > 1 ? work / name / ("threads" + std::to_string(thread_counts[k])) : work / name;
-          OurRun one = run_ours_3d(input, level, thread_counts[k], dir, target_deg);
+          OurRun one = run_ours_3d(input, level, thread_counts[k], dir, target_deg, size);
           if (!one.ok || !best[k].ok || one.wall_seconds < best[k].wall_seconds) best[k] = std::move(one);
         }
       const OurRun& run = best.front();
+      if (run.ok) level = static_cast<int>(run.level);  // the level the size gave
+      const std::string level_cell = std::to_string(level) + (size > 0 ? " (size " + sci(size, 3) + ")" : "");
       if (thread_counts.size() > 1 && run.ok) {
         const std::string first = read_text(work / name / ("threads" + std::to_string(threads)) / "mesh.msh");
         for (std::size_t k = 0; k < thread_counts.size(); ++k) {
           const OurRun& b = best[k];
           if (!b.ok) continue;
           const bool same = read_text(work / name / ("threads" + std::to_string(thread_counts[k])) / "mesh.msh") == first;
-          threads_table << "| " << name << " | " << level << " | " << thread_counts[k] << " | " << repeat << " | "
+          threads_table << "| " << name << " | " << level_cell << " | " << thread_counts[k] << " | " << repeat << " | "
                         << fixed(b.wall_seconds) << " | " << fixed(b.cpu_seconds) << " | " << fixed(b.cpu_seconds / b.wall_seconds, 2)
                         << " | " << fixed(run.wall_seconds / b.wall_seconds, 2) << "x | " << (same ? "yes" : "NO") << " |\n";
-          all_threads.emplace_back(name + " L" + std::to_string(level) + " t" + std::to_string(thread_counts[k]), b);
+          all_threads.emplace_back(tag + " t" + std::to_string(thread_counts[k]), b);
           nlohmann::json jt;
           jt["input"] = name;
           jt["level"] = level;
+          if (size > 0) jt["size"] = size;
           jt["threads"] = thread_counts[k];
           jt["repeat"] = repeat;
           jt["same_mesh_as_first"] = same;
@@ -180,7 +256,7 @@ int main(int argc, char** argv) {
       const double ratio = t.ok ? run.elements_per_second() / t.elements_per_second() : 0.0;
       const double cpu_ratio = t.ok ? (double(run.elements) / run.cpu_seconds) / t.elements_per_cpu_second() : 0.0;
       std::ostringstream row;
-      row << "| " << name << " | " << level << " | " << run.elements << " | " << fixed(run.wall_seconds) << " | "
+      row << "| " << name << " | " << level_cell << " | " << run.elements << " | " << fixed(run.wall_seconds) << " | "
           << fixed(run.cpu_seconds) << " | " << sci(run.elements_per_second()) << " | "
           << sci(double(run.elements) / run.cpu_seconds) << " | " << fixed(run.peak_bytes / 1e6, 1) << " | "
           << fixed(run.bytes_per_element(), 0) << " | " << fixed(run.min_dihedral_deg, 2) << " | ";
@@ -196,6 +272,7 @@ int main(int argc, char** argv) {
       nlohmann::json j;
       j["input"] = name;
       j["level"] = level;
+      if (size > 0) j["size"] = size, j["target_tets"] = target;
       j["threads"] = threads;
       j["target_dihedral_deg"] = target_deg;
       j.update(run_json(run));

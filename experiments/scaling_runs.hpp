@@ -142,22 +142,26 @@ inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int thr
   return run;
 }
 
-/// mesh3d at `level` with the CLI's defaults; `target_dihedral_deg` as the CLI's
-/// --target-dihedral (the sweeps' aim and the edge removal's bar).
+/// mesh3d at `level` (or, with `size` > 0, at Options3d::size, the CLI's --size) with the CLI's
+/// defaults; `target_dihedral_deg` as the CLI's --target-dihedral (the sweeps' aim and the edge
+/// removal's bar).
 inline OurRun run_ours_3d(const std::string& path, int level, int threads, const fs::path& dir,
-                          double target_dihedral_deg = dim3::Options3d{}.target_dihedral_deg) {
+                          double target_dihedral_deg = dim3::Options3d{}.target_dihedral_deg, double size = 0.0) {
   double min_deg = -1.0;
+  int level_used = level;
   OurRun run = timed_run<3>(dir, threads, [&] {
     dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
     dim3::Options3d opt;
     opt.level = level;
+    opt.size = size;
     opt.n_threads = threads;
     dim3::set_target_dihedral(opt, target_dihedral_deg);
     dim3::Result3d r = dim3::mesh3d(s, opt);
     if (r.quality) min_deg = r.quality->min_angle_deg;  // mesh3d's summary, ranking the run
+    level_used = r.level;
     return std::pair{std::move(r.fe.mesh), std::move(r.times)};
   });
-  run.level = level;
+  run.level = level_used;
   run.min_dihedral_deg = min_deg;
   return run;
 }

@@ -283,3 +283,31 @@ TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in
   CHECK(a["validation"]["valid"] == true);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh3d --size: the octants' side instead of a level; with --level, or past level 9, bad usage",
+          "[cli][mesh3d][size]") {
+  // sphere966: the largest extent 20, the default root cube 21 across; its level-3 octant 2.625.
+  // --size 2 is level 4 (1.3125) in a cube 1.52x the default: between levels 3 and 4.
+  const SpherePair runs("size", 3, "");
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  REQUIRE(run_status("mesh3d '" + sphere + "' --size 2 --quiet --threads 1 -o '" + (runs.dir / "s").string() + "'") == 0);
+  const auto l3 = runs.report("a"), sized = runs.report("s");
+  CHECK(l3["options"]["level"] == 3);
+  CHECK(l3["options"]["size"].is_null());
+  CHECK(l3["options"]["root_scale"].get<double>() == 1.0);
+  CHECK(sized["options"]["level"] == 4);
+  CHECK(sized["options"]["size"].get<double>() == 2.0);
+  CHECK(sized["options"]["root_scale"].get<double>() == Approx(2.0 * 16 / 21));
+  CHECK(sized["counts"]["tetrahedra"].get<long>() > l3["counts"]["tetrahedra"].get<long>());
+  const auto out = runs.dir / "c";
+  CHECK(run_status("mesh3d '" + sphere + "' --quiet --size 2 --level 4 -o '" + out.string() + "'") == 2);
+  CHECK(run_status("mesh3d '" + sphere + "' --quiet --size 0 -o '" + out.string() + "'") == 2);
+  // 21 / 512 = 0.041 is level 9's octant; 0.04 would be level 10.
+  const std::string err = (runs.dir / "err.txt").string();
+  const std::string cmd = std::string("'") + FEBEMESH_CLI + "' mesh3d '" + sphere + "' --quiet --size 0.04 -o '" + out.string() +
+                          "' 2>'" + err + "'";
+  const int st = std::system(cmd.c_str());
+  CHECK((WIFEXITED(st) ? WEXITSTATUS(st) : -1) == 2);
+  CHECK(read_text(err).find("needs level 10") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(out));
+}

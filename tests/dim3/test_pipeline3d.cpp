@@ -774,3 +774,88 @@ TEST_CASE("mesh3d's lattice draws take a mesh that loses more of the volume than
   CHECK(has("lattice draw 2: no work bound left; not made"));
   CHECK(s.root_shift() == P3::Zero());
 }
+
+// Options3d::size: the level whose octants are no larger, in a root cube enlarged so that they
+// are exactly the size.
+TEST_CASE("level_for_size: the level and root scale whose octants have the size asked", "[pipeline3d][size]") {
+  Box<3> b;
+  b.lo = P3(-1.0, 0.0, 0.0);
+  b.hi = P3(1.0, 0.5, 0.25);  // the largest extent 2: the default cube 2.1 across
+  const double side = 2.1;
+  for (const double size : {0.3, 0.13125, 0.1, 0.02, 0.0042}) {
+    const SizedLevel sl = level_for_size(b, size);
+    INFO("size " << size << ": level " << sl.level << ", scale " << sl.root_scale);
+    CHECK(sl.level >= 1);
+    CHECK(sl.root_scale >= 1.0);
+    CHECK(sl.root_scale < 2.0);
+    CHECK(side * sl.root_scale / std::ldexp(1.0, sl.level) == Approx(size).epsilon(1e-12));
+  }
+  // The default cube's level-4 octant (2.1 / 16 = 0.13125): level 4 in the default cube.
+  const SizedLevel l4 = level_for_size(b, 0.13125);
+  CHECK(l4.level == 4);
+  CHECK(l4.root_scale == 1.0);
+  CHECK(level_for_size(b, 0.3).level == 3);  // 2.1 / 8 = 0.2625 < 0.3: level 3 in a cube 1.14x
+  CHECK(level_for_size(b, 0.0042).level == 9);  // 2.1 / 512 = 0.0041 <= 0.0042
+  CHECK(level_for_size(b, 0.0041).level == 10);
+}
+
+TEST_CASE("SurfaceBoundary::set_root_scale enlarges the root cube and moves the levels with it", "[pipeline3d][size]") {
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
+  const Box<3> root = s.root_box();
+  std::vector<double> curvature(static_cast<std::size_t>(s.surface().n_triangles()));
+  for (std::int32_t t = 0; t < s.surface().n_triangles(); ++t) curvature[t] = s.curvature_level(t);
+  s.set_root_scale(1.5);
+  CHECK(s.root_scale() == 1.5);
+  CHECK(s.root_box().extent()[0] == Approx(1.5 * root.extent()[0]));
+  CHECK((s.root_box().center() - root.center()).norm() < 1e-12 * root.extent()[0]);
+  // A curvature level asks for cells of a given size: in a cube 1.5x as large, log2(1.5) more.
+  for (std::int32_t t = 0; t < s.surface().n_triangles(); ++t)
+    if (std::isfinite(curvature[t])) CHECK(s.curvature_level(t) == Approx(curvature[t] + std::log2(1.5)));
+  s.set_root_scale(1.0);
+  CHECK(s.root_box().extent()[0] == root.extent()[0]);
+  for (std::int32_t t = 0; t < s.surface().n_triangles(); ++t) CHECK(s.curvature_level(t) == curvature[t]);
+}
+
+// The element count follows the size between the levels' 8x steps; a size that is a level's
+// octant gives that level's mesh, point for point.
+TEST_CASE("mesh3d with Options3d::size: a level's octant is that level, sizes between give counts between",
+          "[pipeline3d][size]") {
+  SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
+  Options3d opt;
+  opt.n_threads = 2;
+  opt.level = 3;
+  const Result3d l3 = mesh3d(s, opt);
+  opt.level = 4;
+  const Result3d l4 = mesh3d(s, opt);
+  CHECK(l3.level == 3);
+  CHECK(l3.root_scale == 1.0);
+  const double side = s.root_box().extent()[0];
+
+  Options3d sized = opt;
+  sized.level = 7;  // not used with a size
+  sized.size = side / 8;
+  const Result3d same = mesh3d(s, sized);
+  CHECK(same.level == 3);
+  CHECK(same.root_scale == 1.0);
+  CHECK(same.fe.mesh.points == l3.fe.mesh.points);
+  CHECK(same.fe.mesh.solid.node == l3.fe.mesh.solid.node);
+
+  std::size_t last = l3.fe.mesh.solid.size();
+  for (const double share : {0.8, 0.6}) {  // level-4 octants 1.6x and 1.2x the default's
+    sized.size = share * side / 8;
+    std::vector<std::string> lines;
+    const Result3d r = mesh3d(s, sized, [&](const std::string& m) { lines.push_back(m); });
+    INFO("size " << sized.size << ": " << r.fe.mesh.solid.size() << " tetrahedra");
+    CHECK(r.level == 4);
+    CHECK(r.root_scale == Approx(2 * share));
+    CHECK(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("size ") == 0; }));
+    CHECK(r.fe.mesh.solid.size() > last);
+    CHECK(r.fe.mesh.solid.size() < l4.fe.mesh.solid.size());
+    last = r.fe.mesh.solid.size();
+    const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+    INFO(v.summary());
+    CHECK(v.valid);
+    CHECK(measure_fidelity(r.fe.mesh, s, 2).volume_rel_error < 0.03);
+  }
+  CHECK(s.root_scale() == Approx(1.2));  // left as the last run set it
+}
