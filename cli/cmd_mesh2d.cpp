@@ -18,6 +18,7 @@
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "core/process_stats.hpp"
+#include "core/sized_level.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
 #include "core/write_vtu.hpp"
@@ -45,6 +46,10 @@ options:
   -o, --output DIR      output folder (written atomically; replaced if it exists)
   --level N             mesh control level at the curve (quadrant size = root / 2^N); default:
                         the file's levels, else automatic from curvature and thickness
+  --size H              instead of --level: the quadrants' side at the curve, in the input's
+                        units (the level whose quadrants are no larger, in a root square
+                        enlarged by less than 2x so that they are H; the element count then
+                        follows H instead of 4x steps; the file's own levels keep their sizes)
   --elements KIND       tri (default) | quad | mixed
   --smooth N            Laplacian smoothing iterations (default 4, as the paper)
   --slide               let boundary nodes slide along the curve while smoothing
@@ -90,7 +95,7 @@ void check_budget(const CurveBoundary& curve, double level, std::size_t max_cell
 
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--slide", "--no-figures", "--no-validate", "--quiet", "--binary"},
-                  {"-o", "--output", "--level", "--elements", "--smooth", "--buffer", "--max-level", "--max-cells",
+                  {"-o", "--output", "--level", "--size", "--elements", "--smooth", "--buffer", "--max-level", "--max-cells",
                    "--threads", "--figures"});
   args.expect_positional({"INPUT"});
   const std::string input = args.positional()[0];
@@ -99,6 +104,11 @@ int run(const std::vector<std::string>& argv) {
 
   Options2d opt;
   opt.level = args.real_or("--level", no_level, 0, 28);
+  double size = 0.0;
+  if (args.has("--size")) {
+    if (args.has("--level")) throw UsageError("--size and --level: give one of them");
+    size = args.real_or("--size", 0.0, 1e-300, 1e300);
+  }
   opt.elements = element_kind_from(args.choice_or("--elements", "tri", {"tri", "quad", "mixed"}));
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 1000);
   opt.slide_boundary = args.has("--slide");
@@ -123,6 +133,19 @@ int run(const std::vector<std::string>& argv) {
   };
   Domain domain = read_domain(input);
   CurveBoundary curve(std::move(domain));
+  if (size > 0) {
+    const SizedLevel sl = level_for_size<2>(curve.bounding_box(), size);
+    if (sl.level > 28) {
+      std::ostringstream os;
+      os << "--size " << size << " on " << input << " needs level " << sl.level << "; the finest is 28";
+      throw UsageError(os.str());
+    }
+    curve.set_root_scale(sl.root_scale);
+    opt.level = sl.level;
+    std::ostringstream os;
+    os << "--size " << size << ": level " << sl.level << " in a root square " << sl.root_scale << "x the default";
+    progress(os.str());
+  }
   if (opt.level != no_level) curve.set_global_level(opt.level);
   curve.set_max_level(opt.max_level);
   check_budget(curve, opt.level != no_level ? opt.level : curve.global_level(), opt.max_cells);
@@ -180,6 +203,8 @@ int run(const std::vector<std::string>& argv) {
     std::ofstream rep(dir.file("report.json"));
     // The CLI's own options (figures, MSH encoding) join the library's in "options".
     nlohmann::ordered_json j = nlohmann::ordered_json::parse(report_json(r, curve, opt, fid, valid, info));
+    j["options"]["size"] = size > 0 ? nlohmann::ordered_json(size) : nlohmann::ordered_json(nullptr);
+    j["options"]["root_scale"] = curve.root_scale();
     j["options"]["figures"] = figures;
     j["options"]["figures_drawn"] = r.stages_kept;
     j["options"]["msh_encoding"] = encoding == MshEncoding::Binary ? "binary" : "ascii";

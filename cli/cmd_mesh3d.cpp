@@ -188,7 +188,7 @@ int run(const std::vector<std::string>& argv) {
   dim3::SurfaceBoundary surface = dim3::SurfaceBoundary::from_file(input);
   if (opt.size > 0) {
     // --level's range for the level --size gives in the given axes (a frame's may differ).
-    const dim3::SizedLevel sl = dim3::level_for_size(surface.bounding_box(), opt.size);
+    const SizedLevel sl = level_for_size<3>(surface.bounding_box(), opt.size);
     const double side = surface.root_box().extent()[0];
     if (sl.level > 9) {
       std::ostringstream os;

@@ -539,8 +539,14 @@ bool CurveBoundary::segment_crosses(const P2& a, const P2& b) const {
 // ---------------------------------------------------------------------------------------------
 // Control levels
 
+void CurveBoundary::set_root_scale(double scale) {
+  root_scale_ = scale;
+  file_level_shift_ = scale == 1.0 ? 0.0 : std::log2(scale);
+  compute_automatic_levels();
+}
+
 Box<2> CurveBoundary::root_box() const {
-  const double side = 1.05 * bbox_.extent().maxCoeff();
+  const double side = 1.05 * bbox_.extent().maxCoeff() * root_scale_;
   const P2 c = bbox_.center();
   return Box<2>{c - P2::Constant(0.5 * side), c + P2::Constant(0.5 * side)};
 }
@@ -644,10 +650,12 @@ void CurveBoundary::compute_automatic_levels() {
 
 double CurveBoundary::control_level(const Box<2>& box) const {
   double lv = 0.0;
-  const double global = global_level_ != no_level ? global_level_ : domain_.default_level;
+  const double global = global_level_ != no_level ? global_level_
+                        : domain_.default_level != no_level ? domain_.default_level + file_level_shift_
+                                                            : no_level;
   if (global != no_level) lv = std::max(lv, global);
   for (const InteriorControl& c : domain_.interior)
-    if (box_distance2(box, c.p) <= c.radius * c.radius) lv = std::max(lv, c.level);
+    if (box_distance2(box, c.p) <= c.radius * c.radius) lv = std::max(lv, c.level + file_level_shift_);
   const bool automatic = is_automatic();
   // Features thinner than the quadrants and bends tighter than them are refined until resolved,
   // even with given levels (at most floor_boost levels above what was asked).
@@ -669,7 +677,8 @@ double CurveBoundary::control_level(const Box<2>& box) const {
              double lo = inf, hi = -inf;
              meeting_range(pc.q, box, 0.0, 1.0, 1e-13 * scale_, 60, lo, hi);
              if (lo > hi) return;
-             lv = std::max({lv, level_at(pc.loop, pc.index + lo), level_at(pc.loop, pc.index + hi)});
+             for (const double at : {level_at(pc.loop, pc.index + lo), level_at(pc.loop, pc.index + hi)})
+               if (at != no_level) lv = std::max(lv, at + file_level_shift_);
            });
   return lv;
 }

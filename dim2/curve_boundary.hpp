@@ -25,7 +25,7 @@
 //     until resolved) and the curvature rule h_L <= 0.3 R still apply, at most 4 levels beyond
 //     the given level.
 // Levels are relative to root_box(), the tree's root: the smallest square around
-// bounding_box() enlarged by 5%.
+// bounding_box() enlarged by 5% (and by set_root_scale).
 
 #include <cstdint>
 #include <vector>
@@ -90,6 +90,12 @@ class CurveBoundary final : public Boundary<2> {
   bool segment_touches(const P2& a, const P2& b) const;
 
   Box<2> root_box() const;
+  /// The root square's side over its default (1.05 x the largest extent), >= 1 (mesh2d's --size,
+  /// core level_for_size): the automatic and floor levels follow the new side, and the levels
+  /// the file gives (on the curve, at interior points, its default) rise by log2(scale), so that
+  /// their quadrants are no larger than in the default square.
+  void set_root_scale(double scale);
+  double root_scale() const { return root_scale_; }
   void set_global_level(double level) { global_level_ = level; }
   double global_level() const { return global_level_; }
   void set_max_level(int level) { max_level_ = level; }
@@ -173,6 +179,8 @@ class CurveBoundary final : public Boundary<2> {
   Box<2> bbox_;
   double scale_ = 1.0;  ///< largest extent of the bounding box
   double global_level_ = no_level;
+  double root_scale_ = 1.0;
+  double file_level_shift_ = 0.0;  ///< log2(root_scale_): added to the levels the file gives
   int max_level_ = 12;
   bool has_curve_levels_ = false;
 };

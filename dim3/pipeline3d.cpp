@@ -459,29 +459,13 @@ P3 lattice_draw_shift(int k) {
   return P3::Zero();
 }
 
-SizedLevel level_for_size(const Box<3>& bounding_box, double size) {
-  const double side = 1.05 * bounding_box.extent().maxCoeff();  // SurfaceBoundary::root_box at scale 1
-  SizedLevel sl;
-  sl.level = std::max(1, static_cast<int>(std::ceil(std::log2(side / size))));
-  sl.root_scale = size * std::ldexp(1.0, sl.level) / side;
-  // A size that is the default cube's octant of some level, to rounding, is that level in the
-  // default cube (the same mesh as --level), not the next one in a cube twice as large.
-  if (std::abs(sl.root_scale - 1.0) < 1e-12) {
-    sl.root_scale = 1.0;
-  } else if (sl.root_scale < 1.0) {  // log2's rounding below a power of two
-    sl.level += 1;
-    sl.root_scale *= 2.0;
-  }
-  return sl;
-}
-
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& progress) {
   // Options3d::size: each surface meshed (the given one, the one turned into its frame, whose
   // bounding box differs) at its own level and root scale.
   const auto sized = [&](SurfaceBoundary& on, const char* where) {
     Options3d o = opt_in;
     if (opt_in.size > 0) {
-      const SizedLevel sl = level_for_size(on.bounding_box(), opt_in.size);
+      const SizedLevel sl = level_for_size<3>(on.bounding_box(), opt_in.size);
       on.set_root_scale(sl.root_scale);
       o.level = sl.level;
       if (progress) {

@@ -15,6 +15,7 @@
 
 #include "core/orthtree.hpp"
 #include "core/quality.hpp"
+#include "core/sized_level.hpp"
 #include "core/stage_timer.hpp"
 #include "core/validate.hpp"
 #include "dim3/boundary_octants.hpp"
@@ -28,7 +29,7 @@ namespace febemesh::dim3 {
 struct Options3d {
   int level = 4;                     ///< global level at the surface
   /// The octants' side at the surface in the surface's units (0: by `level`). mesh3d then meshes
-  /// at the level whose octants in the default root cube are no larger (level_for_size) and
+  /// at the level whose octants in the default root cube are no larger (core level_for_size) and
   /// enlarges the root cube by less than 2x (SurfaceOptions::root_scale) so that they have this
   /// side; the curvature, feature and thickness levels follow the root cube.
   double size = 0.0;
@@ -370,15 +371,6 @@ inline void set_target_dihedral(Options3d& opt, double deg) {
   opt.remove_edges_below_deg = deg;
   opt.contract_edges_below_deg = std::min(Options3d{}.contract_edges_below_deg, deg);
 }
-
-/// Options3d::size on a surface with this bounding box: the level whose octants in the default
-/// root cube (1.05 x the largest extent) are no larger than `size`, at least 1, and the root
-/// scale (in [1, 2) unless `size` needs a level under 1) that makes that level's octants `size`.
-struct SizedLevel {
-  int level = 1;
-  double root_scale = 1.0;
-};
-SizedLevel level_for_size(const Box<3>& bounding_box, double size);
 
 /// The root cube's shift of lattice draw k (1, 2; Options3d::lattice_draws), in shares of its
 /// side (SurfaceOptions::root_shift); zero for k = 0.

@@ -1,8 +1,8 @@
 // bench_mesh2d: febemesh against Gmsh, end to end, at the same element count (issue 8).
 //
 // For every input (the bundled parts and a few glyphs) and every target size, a level is chosen
-// so that the mesh lands near the target: untimed runs search for the level whose count is within
-// 10% of it (aim_level). The run is then timed from the parsed input to a written mesh.msh
+// so that the mesh lands near the target: untimed runs search for the quadrant size (the CLI's
+// --size) whose count is within 5% of it (aim_size). The run is then timed from the parsed input to a written mesh.msh
 // (experiments/scaling_runs.hpp); Gmsh meshes the same exact curves (dim2/compare_gmsh's .geo)
 // with a uniform size rescaled until its triangle count is within 20% of ours. The table gives both speeds, both memories per element and the ratio.
 //
@@ -13,9 +13,7 @@
 //   it is skipped with a message (default 6 GB: the machine is shared).
 //   --gmsh-max: no Gmsh run above this many elements (default 1.2e6; Gmsh takes ~30 s per 10^6).
 //   --elements: tri (default), quad or mixed.
-//   --levels: run these levels instead of searching levels for --sizes (the element count is a
-//   step function of the level on some inputs, e.g. the flange jumps from 85k at 8 to 340k at
-//   8.23, so the search may end further than 10% from its target; it takes the nearest count).
+//   --levels: run these levels instead of searching sizes for --sizes.
 // Output: tables on stdout, results/bench_mesh2d.md and results/bench_mesh2d.json.
 
 #include <algorithm>
@@ -42,12 +40,12 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-/// The element count of mesh2d at `level` (-1 where the tree would pass its size limit).
-double count_at(const dim2::CurveBoundary& base, double level, dim2::ElementKind elements, int threads) {
+/// The element count of mesh2d at quadrant size `size` (the CLI's --size; -1 where the tree
+/// would pass its size limit).
+double count_at(const dim2::CurveBoundary& base, double size, dim2::ElementKind elements, int threads) {
   dim2::CurveBoundary curve = base;
-  curve.set_global_level(level);
   dim2::Options2d opt;
-  opt.level = level;
+  opt.level = sized_curve(curve, size).level;
   opt.keep_stages = false;
   opt.n_threads = threads;
   opt.elements = elements;
@@ -59,65 +57,44 @@ double count_at(const dim2::CurveBoundary& base, double level, dim2::ElementKind
 }
 
 struct Aim {
-  double level = 0.0;
-  double count = 0.0;  ///< at `level`, from the search's own run
+  double size = 0.0;
+  double count = 0.0;  ///< at `size`, from the search's own run
   int runs = 0;        ///< untimed runs the search made
 };
 
-/// The level (to 0.01) whose element count is nearest `target`, within 10% where the count's
-/// step function allows. Untimed runs: levels 6 and 7, then a search that keeps a bracket in
-/// log(count) against level, reading the next level off the line through the two nearest
-/// points and stepping at most 1.5 levels past the highest run below the target (a fit of
-/// levels 6 and 7 alone put flange's 10^6 at level 10.16, 5.4 x 10^6 elements; bracket's and
-/// naca0012's past the tree's size limit).
-Aim aim_level(const dim2::CurveBoundary& base, double target, dim2::ElementKind elements, int threads) {
+/// The quadrant size (the CLI's --size) whose element count is within 5% of `target`, by
+/// untimed runs (at most 8): the first at the default square's level-7 quadrant, then along a
+/// line in log(count) against log(size) through the two runs nearest the target (the count
+/// grows about as size^-2); the nearest run's size. With levels alone the count is a step
+/// function (flange: 85k at level 8, 340k at 8.23), so a level search could miss 10^6 by 2x.
+Aim aim_size(const dim2::CurveBoundary& base, double target, dim2::ElementKind elements, int threads) {
   struct Point {
-    double level, count;
+    double size, count;
   };
   std::vector<Point> runs;
-  const auto run = [&](double level) {
-    runs.push_back({level, count_at(base, level, elements, threads)});
-    return runs.back();
-  };
-  run(6.0);
-  run(7.0);
-  const auto best = [&] {
-    Aim a;
-    double miss = std::numeric_limits<double>::infinity();
+  const auto miss = [&](const Point& p) { return p.count > 0 ? std::abs(std::log(p.count / target)) : 1e300; };
+  double size = base.root_box().extent()[0] / 128.0;
+  for (int k = 0; k < 8; ++k) {
+    const double n = count_at(base, size, elements, threads);
+    runs.push_back({size, n});
+    if (n > 0 && std::abs(n / target - 1.0) <= 0.05) break;
+    std::vector<Point> ok;
     for (const Point& p : runs)
-      if (p.count > 0 && std::abs(std::log(p.count / target)) < miss) miss = std::abs(std::log(p.count / target)), a.level = p.level, a.count = p.count;
-    a.runs = int(runs.size());
-    return a;
-  };
-  for (int iter = 0; iter < 10; ++iter) {
-    const Aim now = best();
-    if (now.count > 0 && std::abs(now.count / target - 1.0) <= 0.1) return now;
-    // The bracket: the highest level below the target and the lowest above (or refused).
-    double lo = -1.0, lo_n = 0.0, hi = 1e9, hi_n = 0.0;
-    for (const Point& p : runs) {
-      if (p.count > 0 && p.count < target && p.level > lo) lo = p.level, lo_n = p.count;
-      if ((p.count < 0 || p.count > target) && p.level < hi) hi = p.level, hi_n = p.count;
+      if (p.count > 0) ok.push_back(p);
+    if (ok.empty()) {
+      size *= 2.0;  // refused: coarser
+      continue;
     }
-    double next;
-    if (hi > 1e8) {  // nothing above yet: extrapolate from the two highest levels below
-      double lo2 = -1.0, lo2_n = 0.0;
-      for (const Point& p : runs)
-        if (p.count > 0 && p.level < lo && p.level > lo2) lo2 = p.level, lo2_n = p.count;
-      const double slope = std::clamp(std::log2(lo_n / lo2_n) / (lo - lo2), 0.5, 2.5);  // log2(count) per level
-      next = std::min(lo + std::log2(target / lo_n) / slope, lo + 1.5);
-    } else if (lo < 0) {  // nothing below: halve the way down
-      next = hi - 1.0;
-    } else if (hi_n > 0) {  // between: the line through the bracket in log(count)
-      next = lo + (hi - lo) * std::log(target / lo_n) / std::log(hi_n / lo_n);
-      next = std::clamp(next, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
-    } else {
-      next = 0.5 * (lo + hi);
-    }
-    next = std::round(next * 100.0) / 100.0;
-    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return p.level == next; })) break;
-    run(next);
+    std::sort(ok.begin(), ok.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
+    double slope = -2.0;  // d log(count) / d log(size)
+    if (ok.size() >= 2 && ok[0].size != ok[1].size && ok[0].count != ok[1].count)
+      slope = std::clamp(std::log(ok[0].count / ok[1].count) / std::log(ok[0].size / ok[1].size), -3.0, -1.0);
+    const double next = ok[0].size * std::pow(target / ok[0].count, 1.0 / slope);
+    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return std::abs(p.size / next - 1.0) < 1e-6; })) break;
+    size = next;
   }
-  return best();
+  const auto best = std::min_element(runs.begin(), runs.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
+  return {best->size, best->count, static_cast<int>(runs.size())};
 }
 
 }  // namespace
@@ -205,15 +182,16 @@ int main(int argc, char** argv) {
         continue;
       }
       // Levels are real: the control level interpolates the cell size between powers of two.
-      double level = size_or_level;
+      double level = size_or_level, size = 0.0;
       if (sized) {
-        const Aim aim = aim_level(*base, target, elements, threads);
-        level = aim.level;
-        std::cout << "  " << tag << ": level " << level << " (" << aim.runs << " untimed runs; " << std::int64_t(aim.count)
-                  << " elements)\n"
+        const Aim aim = aim_size(*base, target, elements, threads);
+        size = aim.size;
+        level = level_for_size<2>(base->bounding_box(), size).level;
+        std::cout << "  " << tag << ": size " << size << ", level " << level << " (" << aim.runs << " untimed runs; "
+                  << std::int64_t(aim.count) << " elements)\n"
                   << std::flush;
       }
-      const OurRun run = run_ours_2d(*base, level, threads, work / name, elements);
+      const OurRun run = run_ours_2d(*base, level, threads, work / name, elements, size);
       if (!run.ok) {
         std::cout << "  " << tag << ": febemesh failed: " << run.error << "\n";
         skipped << "- " << tag << ": febemesh failed: " << run.error << "\n";
@@ -225,7 +203,8 @@ int main(int argc, char** argv) {
       const double ratio = g.ok ? run.elements_per_second() / g.elements_per_second() : 0.0;
       const double cpu_ratio = g.ok ? (double(run.elements) / run.cpu_seconds) / g.elements_per_cpu_second() : 0.0;
       std::ostringstream row;
-      row << "| " << name << " | " << (sized ? sci(target, 2) : "-") << " | " << level << " | " << run.elements << " | "
+      row << "| " << name << " | " << (sized ? sci(target, 2) : "-") << " | " << level
+          << (sized ? " (size " + sci(size, 3) + ")" : std::string()) << " | " << run.elements << " | "
           << fixed(run.wall_seconds) << " | " << fixed(run.cpu_seconds) << " | " << sci(run.elements_per_second())
           << " | " << sci(double(run.elements) / run.cpu_seconds) << " | " << fixed(run.peak_bytes / 1e6, 1) << " | "
           << fixed(run.bytes_per_element(), 0) << " | ";
@@ -241,7 +220,7 @@ int main(int argc, char** argv) {
 
       nlohmann::json j;
       j["input"] = name;
-      if (sized) j["target"] = target;
+      if (sized) j["target"] = target, j["size"] = size;
       j["level"] = level;
       j["threads"] = threads;
       j.update(run_json(run));

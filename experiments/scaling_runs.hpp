@@ -35,6 +35,7 @@
 #include "core/process_stats.hpp"
 #include "core/quality.hpp"
 #include "core/read_msh.hpp"
+#include "core/sized_level.hpp"
 #include "core/stage_timer.hpp"
 #include "core/write_msh.hpp"
 #include "dim2/compare_gmsh.hpp"
@@ -125,10 +126,21 @@ template <int Dim, class Body> OurRun timed_run(const fs::path& dir, int threads
   return run;
 }
 
+/// The curve at the level and root scale of the CLI's --size (core level_for_size).
+inline SizedLevel sized_curve(dim2::CurveBoundary& curve, double size) {
+  const SizedLevel sl = level_for_size<2>(curve.bounding_box(), size);
+  curve.set_root_scale(sl.root_scale);
+  curve.set_global_level(sl.level);
+  return sl;
+}
+
+/// mesh2d at `level` (or, with `size` > 0, as the CLI's --size) from the parsed input.
 inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir,
-                          dim2::ElementKind elements = dim2::ElementKind::Tri) {
+                          dim2::ElementKind elements = dim2::ElementKind::Tri, double size = 0.0) {
+  if (size > 0) level = level_for_size<2>(base.bounding_box(), size).level;
   OurRun run = timed_run<2>(dir, threads, [&] {
     dim2::CurveBoundary curve = base;
+    if (size > 0) sized_curve(curve, size);
     curve.set_global_level(level);
     dim2::Options2d opt;
     opt.level = level;

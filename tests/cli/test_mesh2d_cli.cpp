@@ -226,3 +226,42 @@ TEST_CASE("mesh2d and mesh3d refuse a tree over --max-cells: the file, the reaso
   CHECK_FALSE(std::filesystem::exists(dir));
   CHECK(run("mesh3d '" + sphere + "' -o '" + dir.string() + "' --max-cells 10 --quiet").status == 2);  // under 100
 }
+
+TEST_CASE("mesh2d --size: the quadrants' side instead of a level; the count follows it", "[cli][mesh2d][size]") {
+  // The flange is 6 x 6 (the default root square 6.3 across): level 6's quadrant is 6.3 / 64.
+  // Sizes between level 6's and level 7's give counts between theirs; level 6's own size gives
+  // level 6's mesh.
+  const auto dir = scratch("size");
+  std::filesystem::remove_all(dir);
+  const auto mesh = [&](const std::string& name, const std::string& args) {
+    const Run r = run("mesh2d '" + flange + "' -o '" + (dir / name).string() + "' --threads 1 --no-figures --quiet " + args);
+    INFO(args << "\n" << r.output);
+    REQUIRE(r.status == 0);
+    return nlohmann::json::parse(read_text(dir / name / "report.json"));
+  };
+  const auto l6 = mesh("l6", "--level 6"), l7 = mesh("l7", "--level 7");
+  char same[64];
+  std::snprintf(same, sizeof same, "--size %.17g", 6.3 / 64);
+  const auto s6 = mesh("s6", same);
+  CHECK(s6["options"]["root_scale"].get<double>() == 1.0);
+  CHECK(s6["options"]["level"].get<double>() == 6.0);
+  CHECK(read_text(dir / "s6" / "mesh.msh") == read_text(dir / "l6" / "mesh.msh"));
+  CHECK(l6["options"]["size"].is_null());
+  const auto count = [](const nlohmann::json& j) { return j["counts"]["fe_elements"].get<long>(); };
+  long last = count(l6);
+  for (const auto& [name, share] : {std::pair{"s80", 0.8}, std::pair{"s60", 0.6}}) {  // level-7 quadrants 1.6x, 1.2x
+    char arg[64];
+    std::snprintf(arg, sizeof arg, "--size %.17g", share * 6.3 / 64);
+    const auto j = mesh(name, arg);
+    INFO(arg);
+    CHECK(j["options"]["level"].get<double>() == 7.0);
+    CHECK(j["options"]["root_scale"].get<double>() == Approx(2 * share).epsilon(1e-5));
+    CHECK(count(j) > last);
+    CHECK(count(j) < count(l7));
+    last = count(j);
+  }
+  CHECK(run("mesh2d '" + flange + "' -o '" + (dir / "x").string() + "' --size 0.1 --level 6").status == 2);
+  CHECK(run("mesh2d '" + flange + "' -o '" + (dir / "x").string() + "' --size -1").status == 2);
+  CHECK_FALSE(std::filesystem::exists(dir / "x"));
+  std::filesystem::remove_all(dir);
+}

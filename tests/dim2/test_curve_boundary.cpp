@@ -260,3 +260,24 @@ TEST_CASE("every shared 2D data file passes the checks and orients consistently"
     }
   }
 }
+
+TEST_CASE("set_root_scale enlarges the root square; the file's levels keep their quadrant sizes", "[boundary][size]") {
+  Domain d;
+  d.loops.push_back(square(0.0, 0.0, 2.0, true, "outer"));
+  d.interior.push_back({P2(1.0, 1.0), 6.0, 0.1});  // level 6 within 0.1 of the centre
+  CurveBoundary c(d);
+  const Box<2> root = c.root_box();
+  CHECK(c.root_scale() == 1.0);
+  Box<2> at_centre;
+  at_centre.lo = P2(0.99, 0.99);
+  at_centre.hi = P2(1.01, 1.01);
+  CHECK(c.control_level(at_centre) == 6.0);
+  c.set_root_scale(1.5);
+  CHECK(c.root_box().extent()[0] == Approx(1.5 * root.extent()[0]));
+  CHECK((c.root_box().center() - root.center()).norm() < 1e-12);
+  // The same quadrant size asks log2(1.5) levels more of a square 1.5x as large.
+  CHECK(c.control_level(at_centre) == Approx(6.0 + std::log2(1.5)));
+  c.set_root_scale(1.0);
+  CHECK(c.control_level(at_centre) == 6.0);
+  CHECK(c.root_box().extent()[0] == root.extent()[0]);
+}

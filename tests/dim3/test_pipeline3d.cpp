@@ -775,30 +775,6 @@ TEST_CASE("mesh3d's lattice draws take a mesh that loses more of the volume than
   CHECK(s.root_shift() == P3::Zero());
 }
 
-// Options3d::size: the level whose octants are no larger, in a root cube enlarged so that they
-// are exactly the size.
-TEST_CASE("level_for_size: the level and root scale whose octants have the size asked", "[pipeline3d][size]") {
-  Box<3> b;
-  b.lo = P3(-1.0, 0.0, 0.0);
-  b.hi = P3(1.0, 0.5, 0.25);  // the largest extent 2: the default cube 2.1 across
-  const double side = 2.1;
-  for (const double size : {0.3, 0.13125, 0.1, 0.02, 0.0042}) {
-    const SizedLevel sl = level_for_size(b, size);
-    INFO("size " << size << ": level " << sl.level << ", scale " << sl.root_scale);
-    CHECK(sl.level >= 1);
-    CHECK(sl.root_scale >= 1.0);
-    CHECK(sl.root_scale < 2.0);
-    CHECK(side * sl.root_scale / std::ldexp(1.0, sl.level) == Approx(size).epsilon(1e-12));
-  }
-  // The default cube's level-4 octant (2.1 / 16 = 0.13125): level 4 in the default cube.
-  const SizedLevel l4 = level_for_size(b, 0.13125);
-  CHECK(l4.level == 4);
-  CHECK(l4.root_scale == 1.0);
-  CHECK(level_for_size(b, 0.3).level == 3);  // 2.1 / 8 = 0.2625 < 0.3: level 3 in a cube 1.14x
-  CHECK(level_for_size(b, 0.0042).level == 9);  // 2.1 / 512 = 0.0041 <= 0.0042
-  CHECK(level_for_size(b, 0.0041).level == 10);
-}
-
 TEST_CASE("SurfaceBoundary::set_root_scale enlarges the root cube and moves the levels with it", "[pipeline3d][size]") {
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
   const Box<3> root = s.root_box();
