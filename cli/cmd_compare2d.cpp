@@ -8,6 +8,7 @@
 #include "cli/args.hpp"
 #include "cli/command.hpp"
 #include "cli/compare_report.hpp"
+#include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "dim2/compare_gmsh.hpp"
@@ -28,6 +29,7 @@ its element count is within the tolerance of ours, and measures both meshes with
 options:
   -o, --output DIR   output folder (written atomically; replaced if it exists)
   --level N          febemesh's level at the curve (default: the file's levels, else automatic)
+  --size H           instead of --level: febemesh's quadrant side at the curve (as mesh2d's)
   --elements KIND    tri (default) | quad | mixed. Gmsh: tri = its default triangles; mixed =
                      Mesh.RecombineAll with Blossom (quad-dominant; it may pair all); quad =
                      the same plus Mesh.SubdivisionAlgorithm 1 (all quads, one split more, as
@@ -70,13 +72,14 @@ nlohmann::ordered_json metrics_json(const MeshMetrics2d& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--elements", "--gmsh", "--tolerance", "--iterations"});
+  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--size", "--elements", "--gmsh", "--tolerance", "--iterations"});
   args.expect_positional({"INPUT"});
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
   if (out.empty()) throw UsageError("missing -o DIR");
   Options2d opt;
   opt.level = args.real_or("--level", no_level, 0, 20);
+  const double size = size_option(args);
   opt.elements = element_kind_from(args.choice_or("--elements", "tri", {"tri", "quad", "mixed"}));
   opt.keep_stages = false;
   opt.n_threads = 1;
@@ -87,6 +90,11 @@ int run(const std::vector<std::string>& argv) {
   const bool quiet = args.has("--quiet");
 
   CurveBoundary curve(read_domain(input));
+  if (size > 0) {
+    const SizedLevel sl = sized_level<2>(curve.bounding_box(), size, 20, input);
+    curve.set_root_scale(sl.root_scale);
+    opt.level = sl.level;
+  }
   if (opt.level != no_level) curve.set_global_level(opt.level);
 
   AtomicOutputDir dir(out);

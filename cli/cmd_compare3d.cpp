@@ -7,6 +7,7 @@
 #include "cli/args.hpp"
 #include "cli/command.hpp"
 #include "cli/compare_report.hpp"
+#include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "dim3/compare_tetgen.hpp"
@@ -25,6 +26,7 @@ count is within the tolerance of ours, and measures both meshes with the same co
 options:
   -o, --output DIR   output folder (written atomically; replaced if it exists)
   --level N          febemesh's octree level at the surface (1..9, default 4)
+  --size H           instead of --level: febemesh's octant side at the surface (as mesh3d's)
   --extra-levels N   curvature and feature levels above it (0..4, default 2)
   --target-dihedral DEG  febemesh's optimisation aim (0..35, default 30; as mesh3d's)
   --tolerance F      accepted relative difference of the tet counts (default 0.2)
@@ -68,13 +70,14 @@ nlohmann::ordered_json metrics_json(const MeshMetrics3d& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--extra-levels", "--target-dihedral", "--tolerance", "--iterations"});
+  const Args args(argv, {"--quiet"}, {"-o", "--output", "--level", "--size", "--extra-levels", "--target-dihedral", "--tolerance", "--iterations"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
   if (out.empty()) throw UsageError("missing -o DIR");
   Options3d opt;
   opt.level = args.int_or("--level", 4, 1, 9);
+  opt.size = size_option(args);
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.n_threads = 1;
   set_target_dihedral(opt, args.real_or("--target-dihedral", opt.target_dihedral_deg, 0.0, 35.0));
@@ -91,6 +94,7 @@ int run(const std::vector<std::string>& argv) {
   j["input"] = input;
   j["febemesh"] = metrics_json(c.febemesh);
   j["febemesh"]["target_dihedral_deg"] = opt.target_dihedral_deg;
+  if (opt.size > 0) j["febemesh"]["size"] = opt.size;
   j["tetgen"] = metrics_json(c.tetgen);
   j["tetgen"]["switches"] = c.tetgen_switches;
   nlohmann::ordered_json trials = nlohmann::ordered_json::array();

@@ -15,10 +15,10 @@
 #include "cli/command.hpp"
 #include "cli/limit_hint.hpp"
 #include "cli/progress.hpp"
+#include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "core/process_stats.hpp"
-#include "core/sized_level.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
 #include "core/write_vtu.hpp"
@@ -104,11 +104,7 @@ int run(const std::vector<std::string>& argv) {
 
   Options2d opt;
   opt.level = args.real_or("--level", no_level, 0, 28);
-  double size = 0.0;
-  if (args.has("--size")) {
-    if (args.has("--level")) throw UsageError("--size and --level: give one of them");
-    size = args.real_or("--size", 0.0, 1e-300, 1e300);
-  }
+  const double size = size_option(args);
   opt.elements = element_kind_from(args.choice_or("--elements", "tri", {"tri", "quad", "mixed"}));
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 1000);
   opt.slide_boundary = args.has("--slide");
@@ -134,12 +130,7 @@ int run(const std::vector<std::string>& argv) {
   Domain domain = read_domain(input);
   CurveBoundary curve(std::move(domain));
   if (size > 0) {
-    const SizedLevel sl = level_for_size<2>(curve.bounding_box(), size);
-    if (sl.level > 28) {
-      std::ostringstream os;
-      os << "--size " << size << " on " << input << " needs level " << sl.level << "; the finest is 28";
-      throw UsageError(os.str());
-    }
+    const SizedLevel sl = sized_level<2>(curve.bounding_box(), size, 28, input);
     curve.set_root_scale(sl.root_scale);
     opt.level = sl.level;
     std::ostringstream os;

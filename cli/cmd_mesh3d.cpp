@@ -17,6 +17,7 @@
 #include "cli/command.hpp"
 #include "cli/limit_hint.hpp"
 #include "cli/progress.hpp"
+#include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
 #include "core/quality.hpp"
@@ -146,10 +147,7 @@ int run(const std::vector<std::string>& argv) {
   if (!out) throw UsageError("missing -o DIR");
   dim3::Options3d opt;
   opt.level = args.int_or("--level", 4, 1, 9);
-  if (args.has("--size")) {
-    if (args.has("--level")) throw UsageError("--size and --level: give one of them");
-    opt.size = args.real_or("--size", 0.0, 1e-300, 1e300);
-  }
+  opt.size = size_option(args);
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
   opt.smoothing_iterations = args.int_or("--smooth", 4, 0, 50);
@@ -186,17 +184,8 @@ int run(const std::vector<std::string>& argv) {
   const auto t0 = std::chrono::steady_clock::now();
   progress("reading " + input);
   dim3::SurfaceBoundary surface = dim3::SurfaceBoundary::from_file(input);
-  if (opt.size > 0) {
-    // --level's range for the level --size gives in the given axes (a frame's may differ).
-    const SizedLevel sl = level_for_size<3>(surface.bounding_box(), opt.size);
-    const double side = surface.root_box().extent()[0];
-    if (sl.level > 9) {
-      std::ostringstream os;
-      os << "--size " << opt.size << " on " << input << " (root cube " << side << " across) needs level " << sl.level
-         << "; the finest is 9, octants of " << side / 512 << " or more";
-      throw UsageError(os.str());
-    }
-  }
+  // --level's range for the level --size gives in the given axes (a frame's may differ).
+  if (opt.size > 0) sized_level<3>(surface.bounding_box(), opt.size, 9, input);
   const double t_read = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   dim3::Result3d r;

@@ -78,10 +78,12 @@ TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both to
 TEST_CASE("compare3d warns when TetGen cannot come down to our tet count", "[cli][compare]") {
   // At level 3 we make ~2,800 tets; TetGen's smallest mesh of the 966 input triangles is ~4x more.
   const auto out = tmp_dir() / "coarse";
-  // (With a lower optimisation aim, passed on to mesh3d: --target-dihedral.)
-  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --target-dihedral 20 --quiet") == 0);
+  // (With a lower optimisation aim, passed on to mesh3d: --target-dihedral; and level 3 asked as
+  // its octant's size, 21 / 8 in the default root cube: --size, the same mesh as --level 3.)
+  REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --size 2.625 --target-dihedral 20 --quiet") == 0);
   const auto j = read_json(out / "comparison.json");
   CHECK(j["febemesh"]["target_dihedral_deg"].get<double>() == 20.0);
+  CHECK(j["febemesh"]["size"].get<double>() == 2.625);
   CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() >= 15.0);
   CHECK(j["febemesh"]["min_dihedral_deg"].get<double>() < 25.0);  // (30.00 at the default aim)
   CHECK(run_status("compare3d '" + sphere() + "' -o '" + (out / "x").string() + "' --target-dihedral 40 --quiet") == 2);
@@ -103,6 +105,7 @@ TEST_CASE("compare3d refuses bad input and bad usage", "[cli][compare]") {
   // Usage: no output folder, a level out of range, an unknown option.
   CHECK(run_status("compare3d '" + sphere() + "'") == 2);
   CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 99") == 2);
+  CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --size 2") == 2);
   CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --frobnicate") == 2);
   CHECK(!std::filesystem::exists(out));
   std::filesystem::remove_all(dir);

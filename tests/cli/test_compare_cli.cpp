@@ -120,6 +120,10 @@ TEST_CASE("compare2d refuses bad usage and bad input", "[cli][compare]") {
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
                    "/examples/flange.json' -o /tmp/febemesh_compare_never --elements hex") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json'") == 2);
+  CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
+                   "/examples/flange.json' -o /tmp/febemesh_compare_never --level 6 --size 0.1") == 2);
+  CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
+                   "/examples/flange.json' -o /tmp/febemesh_compare_never --size 1e-9") == 2);  // past level 20
   CHECK(run_status("compare2d /nonexistent.json -o /tmp/febemesh_compare_never") == 1);
   CHECK(!std::filesystem::exists("/tmp/febemesh_compare_never"));
 }
