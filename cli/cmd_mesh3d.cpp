@@ -8,6 +8,7 @@
 #include <fstream>
 #include <future>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -36,6 +37,26 @@ std::string fmt_g(double x) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", x);
   return text;
+}
+
+/// Where a mesh misses volume: how much of the surface lies on parts thinner than two octants
+/// of `cell` (their side at the surface), how thin they get, and the --size that would put two
+/// octants across the thinnest (or that it is finer than the finest level allows). Empty when no
+/// part is that thin.
+std::string thin_parts(dim3::SurfaceBoundary& surface, double cell) {
+  if (!(cell > 0)) return {};
+  const double share = surface.thin_share(2.0 * cell);
+  if (!(share > 0)) return {};
+  double thinnest = std::numeric_limits<double>::infinity();
+  for (const double t : surface.thicknesses())
+    if (t > 0) thinnest = std::min(thinnest, t);
+  const double finest = surface.root_box().extent()[0] / surface.root_scale() / 512.0;  // level 9, default cube
+  std::ostringstream os;
+  os.precision(3);
+  os << "; " << 100.0 * share << "% of the surface's area lies on parts thinner than two octants (2 x " << cell
+     << "), down to " << thinnest << " thick: two octants across that are --size " << thinnest / 2;
+  if (thinnest / 2 < finest) os << ", finer than level 9 allows (" << finest << ")";
+  return os.str();
 }
 
 const char* help_text =
@@ -237,6 +258,7 @@ int run(const std::vector<std::string>& argv) {
   rep["options"] = {{"level", r.level},
                     {"size", opt.size > 0 ? nlohmann::json(opt.size) : nlohmann::json(nullptr)},
                     {"root_scale", r.root_scale},
+                    {"cell_size", r.cell_size},
                     {"extra_levels", opt.extra_levels},
                     {"elements", elements},
                     {"buffer", opt.buffer},
@@ -380,8 +402,8 @@ int run(const std::vector<std::string>& argv) {
       w << "% (parts thinner than the octants are not meshed: every try that refined them was refused,"
         << " and this one does not refine them)";
     else
-      w << "% (parts of the solid are not meshed: thin parts or dropped islands; a higher --level may"
-        << " resolve them)";
+      w << "% (parts of the solid are not meshed: thin parts or dropped islands)";
+    w << thin_parts(surface, r.cell_size);
     warnings.push_back(w.str());
     std::cerr << "febemesh mesh3d: warning: " << w.str() << "\n";
   }

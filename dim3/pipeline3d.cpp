@@ -442,6 +442,13 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
   return d;
 }
 
+/// Result3d::level, root_scale and cell_size of a run on `s` at `level`.
+void set_level_of(Result3d& r, const SurfaceBoundary& s, int level) {
+  r.level = level;
+  r.root_scale = s.root_scale();
+  r.cell_size = s.root_box().extent()[0] / std::ldexp(1.0, level);
+}
+
 /// What is left of a draw's work bound for the next one (0 when nothing is: no draw).
 std::size_t left_of(const Effort& e) { return e.limit > e.used ? e.limit - e.used : 0; }
 
@@ -576,7 +583,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     runs.push_back(run_drawn(on, o, p.draw, limit, origin, progress));
     Drawn& d = runs.back();
     d.in_frame = p.in_frame;
-    if (d.r) d.r->level = o.level, d.r->root_scale = on.root_scale();
+    if (d.r) set_level_of(*d.r, on, o.level);
     in_given_axes(d);
     // Of the runs so far: the lowest rank, then the least volume lost, then the first.
     if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
@@ -623,7 +630,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
   Drawn retry = run_drawn(b.in_frame ? *turned : s, f, b.draw, limit, "the octants of the run it retries", progress, true);
   retry.in_frame = b.in_frame;
   in_given_axes(retry);
-  if (retry.r) retry.r->level = f.level, retry.r->root_scale = (b.in_frame ? *turned : s).root_scale();
+  if (retry.r) set_level_of(*retry.r, b.in_frame ? *turned : s, f.level);
   const bool better = retry.r && (retry.rank < b.rank || (retry.rank == b.rank && retry.min_deg > b.min_deg &&
                                                           retry.error <= std::max(b.error, opt.draw_max_volume_error)));
   if (progress) {

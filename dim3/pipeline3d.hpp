@@ -319,6 +319,7 @@ struct Result3d {
   bool thickness_early = false;      ///< the first tree had problems; this run is Options3d::thickness_probe's tree
   int level = 0;                     ///< the level asked for: Options3d::level, or the one Options3d::size gave
   double root_scale = 1.0;           ///< SurfaceOptions::root_scale of the run (Options3d::size)
+  double cell_size = 0.0;            ///< the octants' side at the surface at `level`: the root cube's side / 2^level
   int level_raised = 0;              ///< refused at the level asked; meshed this many levels finer (raise_levels)
   std::vector<Problem3> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_accepted = 0, n_smoothing_rejected = 0;

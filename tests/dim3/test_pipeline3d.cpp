@@ -805,6 +805,7 @@ TEST_CASE("mesh3d with Options3d::size: a level's octant is that level, sizes be
   const Result3d l4 = mesh3d(s, opt);
   CHECK(l3.level == 3);
   CHECK(l3.root_scale == 1.0);
+  CHECK(l3.cell_size == s.root_box().extent()[0] / 8);
   const double side = s.root_box().extent()[0];
 
   Options3d sized = opt;
@@ -824,6 +825,7 @@ TEST_CASE("mesh3d with Options3d::size: a level's octant is that level, sizes be
     INFO("size " << sized.size << ": " << r.fe.mesh.solid.size() << " tetrahedra");
     CHECK(r.level == 4);
     CHECK(r.root_scale == Approx(2 * share));
+    CHECK(r.cell_size == Approx(sized.size));
     CHECK(std::any_of(lines.begin(), lines.end(), [](const std::string& l) { return l.find("size ") == 0; }));
     CHECK(r.fe.mesh.solid.size() > last);
     CHECK(r.fe.mesh.solid.size() < l4.fe.mesh.solid.size());
