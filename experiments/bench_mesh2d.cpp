@@ -2,7 +2,7 @@
 //
 // For every input (the bundled parts and a few glyphs) and every target size, a level is chosen
 // so that the mesh lands near the target: untimed runs search for the quadrant size (the CLI's
-// --size) whose count is within 5% of it (aim_size). The run is then timed from the parsed input to a written mesh.msh
+// --size) whose count is within 5% of it (experiments/size_search.hpp). The run is then timed from the parsed input to a written mesh.msh
 // (experiments/scaling_runs.hpp); Gmsh meshes the same exact curves (dim2/compare_gmsh's .geo)
 // with a uniform size rescaled until its triangle count is within 20% of ours. The table gives both speeds, both memories per element and the ratio.
 //
@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <iostream>
 #include <limits>
 #include <map>
@@ -26,6 +27,7 @@
 
 #include "core/huge_page_heap.hpp"
 #include "experiments/scaling_runs.hpp"
+#include "experiments/size_search.hpp"
 
 using namespace febemesh;
 using namespace febemesh::bench;
@@ -54,47 +56,6 @@ double count_at(const dim2::CurveBoundary& base, double size, dim2::ElementKind 
   } catch (const LimitError&) {
     return -1.0;
   }
-}
-
-struct Aim {
-  double size = 0.0;
-  double count = 0.0;  ///< at `size`, from the search's own run
-  int runs = 0;        ///< untimed runs the search made
-};
-
-/// The quadrant size (the CLI's --size) whose element count is within 5% of `target`, by
-/// untimed runs (at most 8): the first at the default square's level-7 quadrant, then along a
-/// line in log(count) against log(size) through the two runs nearest the target (the count
-/// grows about as size^-2); the nearest run's size. With levels alone the count is a step
-/// function (flange: 85k at level 8, 340k at 8.23), so a level search could miss 10^6 by 2x.
-Aim aim_size(const dim2::CurveBoundary& base, double target, dim2::ElementKind elements, int threads) {
-  struct Point {
-    double size, count;
-  };
-  std::vector<Point> runs;
-  const auto miss = [&](const Point& p) { return p.count > 0 ? std::abs(std::log(p.count / target)) : 1e300; };
-  double size = base.root_box().extent()[0] / 128.0;
-  for (int k = 0; k < 8; ++k) {
-    const double n = count_at(base, size, elements, threads);
-    runs.push_back({size, n});
-    if (n > 0 && std::abs(n / target - 1.0) <= 0.05) break;
-    std::vector<Point> ok;
-    for (const Point& p : runs)
-      if (p.count > 0) ok.push_back(p);
-    if (ok.empty()) {
-      size *= 2.0;  // refused: coarser
-      continue;
-    }
-    std::sort(ok.begin(), ok.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
-    double slope = -2.0;  // d log(count) / d log(size)
-    if (ok.size() >= 2 && ok[0].size != ok[1].size && ok[0].count != ok[1].count)
-      slope = std::clamp(std::log(ok[0].count / ok[1].count) / std::log(ok[0].size / ok[1].size), -3.0, -1.0);
-    const double next = ok[0].size * std::pow(target / ok[0].count, 1.0 / slope);
-    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return std::abs(p.size / next - 1.0) < 1e-6; })) break;
-    size = next;
-  }
-  const auto best = std::min_element(runs.begin(), runs.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
-  return {best->size, best->count, static_cast<int>(runs.size())};
 }
 
 }  // namespace
@@ -184,7 +145,10 @@ int main(int argc, char** argv) {
       // Levels are real: the control level interpolates the cell size between powers of two.
       double level = size_or_level, size = 0.0;
       if (sized) {
-        const Aim aim = aim_size(*base, target, elements, threads);
+        // Untimed runs from the default square's level-7 quadrant; the count grows about as
+        // size^-2 (a uniform level at the curve, a 2D tree).
+        const SizeAim aim = aim_size(base->root_box().extent()[0] / 128.0, target, 0.05, -2.0, -3.0, -1.0,
+                                     [&](double h) { return count_at(*base, h, elements, threads); });
         size = aim.size;
         level = level_for_size<2>(base->bounding_box(), size).level;
         std::cout << "  " << tag << ": size " << size << ", level " << level << " (" << aim.runs << " untimed runs; "

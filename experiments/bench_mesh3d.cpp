@@ -6,7 +6,7 @@
 // a forked child from reading the .off to writing tetgen.msh (dim3/compare_tetgen). 3D levels
 // are integers, so the sizes step by about 4-8x per level; --tets names tet counts instead, and
 // untimed runs search the octant size (mesh3d's --size, Options3d::size) that gives each within
-// 10% (aim_size).
+// 10% (experiments/size_search.hpp).
 //
 // Usage: bench_mesh3d [--levels 3,4,5 | --tets 1e4,1e5,1e6,5e6] [--inputs a.off,b.off | --all-surfaces]
 //                     [--no-tetgen] [--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]
@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -31,6 +32,7 @@
 
 #include "core/huge_page_heap.hpp"
 #include "experiments/scaling_runs.hpp"
+#include "experiments/size_search.hpp"
 
 using namespace febemesh;
 using namespace febemesh::bench;
@@ -52,57 +54,17 @@ std::vector<std::string> split(const std::string& s) {
   return out;
 }
 
-/// The octant size (Options3d::size) whose tet count is within 10% of `target`, by untimed runs
-/// of mesh3d (at most 8): the first at the default cube's level-4 octant, then along a line in
-/// log(count) against log(size) through the two runs nearest the target (the count grows as
-/// size^-2 to size^-3: the surface's octants, then the volume's); the nearest run's size.
-struct Aim {
-  double size = 0.0;
-  std::size_t count = 0;
-  int runs = 0;
-};
-Aim aim_size(const std::string& path, double target, int threads, double target_deg) {
-  struct Point {
-    double size, count;
-  };
-  std::vector<Point> runs;
-  dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(path);
-  const auto count_at = [&](double size) {
-    dim3::Options3d opt;
-    opt.size = size;
-    opt.n_threads = threads;
-    dim3::set_target_dihedral(opt, target_deg);
-    double n = 0.0;
-    try {
-      n = double(dim3::mesh3d(s, opt).fe.mesh.solid.size());
-    } catch (const std::exception&) {
-      n = 0.0;  // refused: no count (a size too small for the tree's limit is the usual one)
-    }
-    runs.push_back({size, n});
-    return n;
-  };
-  const auto miss = [&](const Point& p) { return p.count > 0 ? std::abs(std::log(p.count / target)) : 1e300; };
-  double size = s.root_box().extent()[0] / 16.0;
-  for (int k = 0; k < 8; ++k) {
-    const double n = count_at(size);
-    if (n > 0 && std::abs(n / target - 1.0) <= 0.1) break;
-    std::vector<Point> ok;
-    for (const Point& p : runs)
-      if (p.count > 0) ok.push_back(p);
-    if (ok.empty()) {
-      size *= 2.0;  // refused: coarser
-      continue;
-    }
-    std::sort(ok.begin(), ok.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
-    double slope = -2.5;  // d log(count) / d log(size)
-    if (ok.size() >= 2 && ok[0].size != ok[1].size && ok[0].count != ok[1].count)
-      slope = std::clamp(std::log(ok[0].count / ok[1].count) / std::log(ok[0].size / ok[1].size), -3.5, -1.5);
-    const double next = ok[0].size * std::pow(target / ok[0].count, 1.0 / slope);
-    if (std::any_of(runs.begin(), runs.end(), [&](const Point& p) { return std::abs(p.size / next - 1.0) < 1e-6; })) break;
-    size = next;
+/// The tets of mesh3d at octant size `size` (Options3d::size, the CLI's --size); 0 where refused.
+double count_at(dim3::SurfaceBoundary& s, double size, int threads, double target_deg) {
+  dim3::Options3d opt;
+  opt.size = size;
+  opt.n_threads = threads;
+  dim3::set_target_dihedral(opt, target_deg);
+  try {
+    return double(dim3::mesh3d(s, opt).fe.mesh.solid.size());
+  } catch (const std::exception&) {
+    return 0.0;  // refused (a size too small for the tree's limit is the usual one)
   }
-  const auto best = std::min_element(runs.begin(), runs.end(), [&](const Point& a, const Point& b) { return miss(a) < miss(b); });
-  return {best->size, static_cast<std::size_t>(best->count), static_cast<int>(runs.size())};
 }
 
 }  // namespace
@@ -207,9 +169,14 @@ int main(int argc, char** argv) {
       }
       double size = 0.0;
       if (target > 0) {
-        const Aim aim = aim_size(input, target, threads, target_deg);
+        // Untimed runs from the default cube's level-4 octant; the count grows as size^-2 to
+        // size^-3 (the surface's octants, then the volume's).
+        dim3::SurfaceBoundary s = dim3::SurfaceBoundary::from_file(input);
+        const SizeAim aim = aim_size(s.root_box().extent()[0] / 16.0, target, 0.1, -2.5, -3.5, -1.5,
+                                     [&](double h) { return count_at(s, h, threads, target_deg); });
         size = aim.size;
-        std::cout << "  " << tag << ": size " << aim.size << " (" << aim.runs << " untimed runs; " << aim.count << " tets)\n"
+        std::cout << "  " << tag << ": size " << aim.size << " (" << aim.runs << " untimed runs; " << std::int64_t(aim.count)
+                  << " tets)\n"
                   << std::flush;
       }
       // Each thread count's fastest of `repeat` runs, the counts taking turns.
