@@ -38,8 +38,10 @@ struct Tally {
   }
 };
 
-test::PipelineOutcome run_case(const PipelineCase& c, Tally& tally) {
+/// The case's domain meshed (on a root square `root_scale` x the default: --size's).
+test::PipelineOutcome run_case(const PipelineCase& c, Tally& tally, double root_scale = 1.0) {
   CurveBoundary curve(test::to_domain(c.domain));
+  if (root_scale != 1.0) curve.set_root_scale(root_scale);
   ++tally.cases;
   try {
     test::PipelineOutcome out = test::run_pipeline(curve, test::to_options(c));
@@ -94,6 +96,19 @@ TEST_CASE("pipeline output is valid on random domains (mixed)", "[property][pipe
 
 TEST_CASE("pipeline output is valid on random domains (quad)", "[property][pipeline2d]") {
   validity_property(ElementKind::Quad, 15);
+}
+
+// --size (CurveBoundary::set_root_scale): the same domains on a root square enlarged by a scale
+// in [1, 2), so on lattices the levels alone never give; the same contract.
+TEST_CASE("pipeline output is valid on random domains in an enlarged root square (--size)", "[property][pipeline2d][size]") {
+  Tally tally;
+  test::prop("whole pipeline output is valid at a root scale in [1, 2)", 15, [&] {
+    const PipelineCase c = *test::gen_pipeline_case(ElementKind::Tri);
+    const double scale = 1.0 + *rc::gen::inRange(0, 1000) / 1000.0;
+    RC_TAG(scale < 1.5 ? "scale < 1.5" : "scale >= 1.5");
+    check_valid(run_case(c, tally, scale));
+  });
+  tally.print("tri, enlarged root square");
 }
 
 TEST_CASE("pipeline is deterministic and its MSH reads back the same", "[property][pipeline2d]") {

@@ -63,11 +63,13 @@ double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws,
                      double draw_below = Options3d{}.draw_min_dihedral_deg,
                      double draw_lost = Options3d{}.draw_max_volume_error,
-                     double flat_retry_below = Options3d{}.flat_retry_below_deg) {
+                     double flat_retry_below = Options3d{}.flat_retry_below_deg, double size_share = 0.0) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
   opt.level = level;
+  // --size: this share of the default cube's octant at `level` (Options3d::size).
+  if (size_share > 0) opt.size = size_share * s.root_box().extent()[0] / std::ldexp(1.0, level);
   opt.align_planar_faces = !given_axes;
   opt.lattice_draws = lattice_draws;
   opt.draw_min_dihedral_deg = draw_below;
@@ -129,12 +131,16 @@ struct Tally {
   }
 };
 
-Outcome3 run_case(const SurfaceSpec& spec, int level, Tally& tally, bool given_axes = false) {
-  RC_LOG() << test::describe(spec) << " at level " << level << (given_axes ? " in its given axes" : "") << "\n";
+Outcome3 run_case(const SurfaceSpec& spec, int level, Tally& tally, bool given_axes = false, double size_share = 0.0) {
+  RC_LOG() << test::describe(spec) << " at level " << level << (given_axes ? " in its given axes" : "");
+  if (size_share > 0) RC_LOG() << ", size " << size_share << " of its octant";
+  RC_LOG() << "\n";
   ++tally.cases;
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    Outcome3 out = run_surface(test::to_surface(spec), level, given_axes);
+    Outcome3 out = run_surface(test::to_surface(spec), level, given_axes, Options3d{}.lattice_draws,
+                               Options3d{}.draw_min_dihedral_deg, Options3d{}.draw_max_volume_error,
+                               Options3d{}.flat_retry_below_deg, size_share);
     tally.max_case_seconds = std::max(
         tally.max_case_seconds, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     if (!out.v.valid) ++tally.invalid;
@@ -249,6 +255,19 @@ TEST_CASE("3D pipeline output is valid on tori", "[property][pipeline3d]") {
 // level finer (Options3d::raise_levels), where it is valid.
 TEST_CASE("3D pipeline output is valid on voxel unions", "[property][pipeline3d]") {
   validity_property("voxel unions", 4, test::gen_voxel_spec(), 3);
+}
+
+// --size (Options3d::size): tori and voxel unions at 1.5 to 2 times the default cube's level-3
+// octant, that is level 3 in a root cube 1.5x to 2x the default: lattices the levels alone
+// never give; the same contract.
+TEST_CASE("3D pipeline output is valid at sizes between the levels (--size)", "[property][pipeline3d][size]") {
+  Tally tally;
+  test::prop("whole 3D pipeline output is valid at a size between the levels", 6, [&] {
+    const SurfaceSpec spec = *rc::gen::oneOf(test::gen_torus_spec(), test::gen_voxel_spec());
+    const double share = 1.5 + *rc::gen::inRange(0, 500) / 1000.0;  // of the level-3 octant
+    check_valid(run_case(spec, 3, tally, *rc::gen::arbitrary<bool>(), share));
+  });
+  tally.print("tori and voxel unions at sizes between the levels");
 }
 
 TEST_CASE("3D pipeline is deterministic and its MSH reads back the same", "[property][pipeline3d]") {
