@@ -159,7 +159,8 @@ int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary"},
-                  {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort", "--max-cells",
+                  {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
+                   "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
                    "--flat-buffer", "--flat-retry-below"});
   args.expect_positional({"SURFACE"});
@@ -232,7 +233,7 @@ int run(const std::vector<std::string>& argv) {
     write_msh(mesh, dir.file("mesh.msh"), encoding);
     write_vtu(mesh, dir.file("mesh.vtu"));
   });
-  progress("validating " + std::to_string(mesh.solid.size()) + " tetrahedra");
+  progress("validating " + std::to_string(mesh.solid.size()) + (opt.hex_dominant ? " solid elements" : " tetrahedra"));
   const auto tv = std::chrono::steady_clock::now();
   std::future<dim3::Fidelity3d> measuring = std::async(launch, [&] {
     return dim3::measure_fidelity(opt.hex_dominant ? triangulated_interface(mesh) : mesh, surface);
@@ -423,8 +424,9 @@ int run(const std::vector<std::string>& argv) {
     if (!os) throw InputError(dir.file("report.json").string() + ": cannot write");
   }
   dir.commit();
-  progress("wrote " + dir.final_path().string() + ": " + std::to_string(mesh.solid.size()) + (opt.hex_dominant ? " solid elements, " : " tetrahedra, ") +
-           std::to_string(mesh.interface.size()) + " interface triangles, min dihedral " +
+  progress("wrote " + dir.final_path().string() + ": " + std::to_string(mesh.solid.size()) +
+           (opt.hex_dominant ? " solid elements, " : " tetrahedra, ") + std::to_string(mesh.interface.size()) +
+           (opt.hex_dominant ? " interface faces" : " interface triangles") + ", min dihedral " +
            std::to_string(q.min_angle_deg) + " deg" + (vr.valid ? "" : " (INVALID)"));
   if (!vr.valid) {
     std::cerr << "febemesh mesh3d: the mesh is not valid:\n" << vr.summary() << "\n";

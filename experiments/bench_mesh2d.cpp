@@ -1,10 +1,11 @@
 // bench_mesh2d: febemesh against Gmsh, end to end, at the same element count (issue 8).
 //
-// For every input (the bundled parts and a few glyphs) and every target size, a level is chosen
-// so that the mesh lands near the target: untimed runs search for the quadrant size (the CLI's
-// --size) whose count is within 5% of it (experiments/size_search.hpp). The run is then timed from the parsed input to a written mesh.msh
-// (experiments/scaling_runs.hpp); Gmsh meshes the same exact curves (dim2/compare_gmsh's .geo)
-// with a uniform size rescaled until its triangle count is within 20% of ours. The table gives both speeds, both memories per element and the ratio.
+// For every input (the bundled parts and a few glyphs) and every target size, untimed runs
+// search for the quadrant size (the CLI's --size) whose count is within 5% of it
+// (experiments/size_search.hpp). The run at that size is then timed from the parsed input to a
+// written mesh.msh (experiments/scaling_runs.hpp); Gmsh meshes the same exact curves
+// (dim2/compare_gmsh's .geo) with a uniform size rescaled until its triangle count is within 20%
+// of ours. The table gives both speeds, both memories per element and the ratio.
 //
 // Usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a.json,b.svg] [--no-gmsh] [--threads N]
 //                     [--memory-budget GB] [--gmsh-max N]
