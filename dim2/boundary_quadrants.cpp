@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <unordered_map>
 
 #include "core/cube_faces.hpp"
@@ -253,6 +255,8 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   // Runs of leaves on opt.n_threads threads, each writing its quadrants after the kept leaves
   // of the runs before it (the serial order).
   const std::size_t n_leaves = t.n_leaves();
+  if (n_leaves > std::numeric_limits<std::uint32_t>::max())  // InteriorQuadrant::leaf
+    throw LimitError("a tree of " + std::to_string(n_leaves) + " quadrants: the quadrant complex holds at most 2^32 - 1");
   const std::size_t run = chunk_size(n_leaves, opt.n_threads, std::size_t(1) << 14);
   const std::vector<std::size_t> run_start =
       chunk_starts(n_leaves, run, opt.n_threads, std::size_t{0}, [&](std::size_t begin, std::size_t end) {
@@ -269,7 +273,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
       if (!in[i]) continue;
       const Cell<2>& c = t.leaf(i);
       InteriorQuadrant& q = qc.interior[out++];
-      q.leaf = i;
+      q.leaf = static_cast<std::uint32_t>(i);
       q.level = c.level;
       for (int k = 0; k < 4; ++k) {
         q.corner_slot[k] = static_cast<std::uint8_t>(q.ring.size());
