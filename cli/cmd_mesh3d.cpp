@@ -50,7 +50,7 @@ std::string thin_parts(dim3::SurfaceBoundary& surface, double cell) {
   double thinnest = std::numeric_limits<double>::infinity();
   for (const double t : surface.thicknesses())
     if (t > 0) thinnest = std::min(thinnest, t);
-  const double finest = surface.root_box().extent()[0] / surface.root_scale() / 512.0;  // level 9, default cube
+  const double finest = default_root_side(surface.bounding_box()) / 512.0;  // level 9, default cube
   std::ostringstream os;
   os.precision(3);
   os << "; " << 100.0 * share << "% of the surface's area lies on parts thinner than two octants (2 x " << cell
@@ -409,10 +409,10 @@ int run(const std::vector<std::string>& argv) {
     std::cerr << "febemesh mesh3d: warning: " << w.str() << "\n";
   }
   if (r.level_raised > 0) {
-    const std::string w = input + ": refused at " + (opt.size > 0 ? "level " : "--level ") + std::to_string(r.level) +
-                          (opt.size > 0 ? " (--size " + fmt_g(opt.size) + ")" : std::string()) + "; meshed at level " +
-                          std::to_string(r.level + r.level_raised) + " (the shape's features are too small for level " +
-                          std::to_string(r.level) + ")";
+    const std::string level = std::to_string(r.level);
+    const std::string asked = opt.size > 0 ? "level " + level + " (--size " + fmt_g(opt.size) + ")" : "--level " + level;
+    const std::string w = input + ": refused at " + asked + "; meshed at level " + std::to_string(r.level + r.level_raised) +
+                          " (the shape's features are too small for level " + level + ")";
     warnings.push_back(w);
     std::cerr << "febemesh mesh3d: warning: " << w << "\n";
   }

@@ -25,7 +25,7 @@ template <int Dim>
 SizedLevel sized_level(const Box<Dim>& box, double size, int finest, const std::string& input) {
   const SizedLevel sl = level_for_size<Dim>(box, size);
   if (sl.level > finest) {
-    const double side = 1.05 * box.extent().maxCoeff();
+    const double side = default_root_side(box);
     std::ostringstream os;
     os << "--size " << size << " on " << input << " (root " << side << " across) needs level " << sl.level
        << "; the finest is " << finest << ", cells of " << side / static_cast<double>(1LL << finest) << " or more";

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
+#include "core/sized_level.hpp"
 #include "dim2/domain_checks.hpp"
 #include "dim2/loop_geometry.hpp"
 
@@ -546,7 +547,7 @@ void CurveBoundary::set_root_scale(double scale) {
 }
 
 Box<2> CurveBoundary::root_box() const {
-  const double side = 1.05 * bbox_.extent().maxCoeff() * root_scale_;
+  const double side = default_root_side(bbox_) * root_scale_;
   const P2 c = bbox_.center();
   return Box<2>{c - P2::Constant(0.5 * side), c + P2::Constant(0.5 * side)};
 }

@@ -514,11 +514,17 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
   std::vector<Plan> plan{{turn, 0}};
   for (int k = 1; k <= draws; ++k) plan.push_back({turn, k});
   if (turn) plan.push_back({false, 0});
-  // A run's mesh back in the given axes, and what its frame was.
-  const auto in_given_axes = [&](Drawn& d) {
+  // The surface and options of a run in the frame or in the given axes.
+  const auto surface_of = [&](bool in_frame) -> SurfaceBoundary& { return in_frame ? *turned : s; };
+  const auto options_of = [&](bool in_frame) -> const Options3d& { return in_frame ? opt_frame : opt; };
+  // A run just made: where it was made, its level, and its mesh back in the given axes with
+  // what its frame was.
+  const auto settle = [&](Drawn& d, bool in_frame) {
+    d.in_frame = in_frame;
     if (!d.r) return;
+    set_level_of(*d.r, surface_of(in_frame), options_of(in_frame).level);
     d.r->frame = frame;
-    if (d.in_frame) {
+    if (in_frame) {
       // Back to the given axes (a rotation: the same volumes, angles and Jacobians up to
       // rounding); the report was of the turned mesh against the turned surface.
       const Eigen::Matrix3d back = frame.to_frame.transpose();
@@ -537,7 +543,6 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
   std::size_t best = 0;
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const Plan& p = plan[i];
-    SurfaceBoundary& on = p.in_frame ? *turned : s;
     std::size_t limit = 0;
     std::string origin;
     if (p.draw > 0) {
@@ -579,12 +584,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
       else
         progress("in the frame of the planar faces: " + what + "; once more in the given axes");
     }
-    const Options3d& o = p.in_frame ? opt_frame : opt;
-    runs.push_back(run_drawn(on, o, p.draw, limit, origin, progress));
+    runs.push_back(run_drawn(surface_of(p.in_frame), options_of(p.in_frame), p.draw, limit, origin, progress));
     Drawn& d = runs.back();
-    d.in_frame = p.in_frame;
-    if (d.r) set_level_of(*d.r, on, o.level);
-    in_given_axes(d);
+    settle(d, p.in_frame);
     // Of the runs so far: the lowest rank, then the least volume lost, then the first.
     if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
     if (d.rank == 0) break;
@@ -611,7 +613,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     return std::move(*b.r);
 
   // Options3d::flat_retry_below_deg: once more on the same lattice with the flat buffer.
-  Options3d f = b.in_frame ? opt_frame : opt;
+  Options3d f = options_of(b.in_frame);
   f.flat_buffer = opt.flat_retry_buffer;
   f.raise_levels = 0;  // (degraded anyway)
   // No retry for thin parts inside it: where the flat buffer leaves a thin part without
@@ -627,10 +629,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
                   b.min_deg, opt.flat_retry_below_deg, opt.flat_retry_buffer);
     progress(text);
   }
-  Drawn retry = run_drawn(b.in_frame ? *turned : s, f, b.draw, limit, "the octants of the run it retries", progress, true);
-  retry.in_frame = b.in_frame;
-  in_given_axes(retry);
-  if (retry.r) set_level_of(*retry.r, b.in_frame ? *turned : s, f.level);
+  Drawn retry = run_drawn(surface_of(b.in_frame), f, b.draw, limit, "the octants of the run it retries", progress, true);
+  settle(retry, b.in_frame);
   const bool better = retry.r && (retry.rank < b.rank || (retry.rank == b.rank && retry.min_deg > b.min_deg &&
                                                           retry.error <= std::max(b.error, opt.draw_max_volume_error)));
   if (progress) {

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "core/error.hpp"
+#include "core/sized_level.hpp"
 #include "dim3/read_surface.hpp"
 #include "dim3/surface_checks.hpp"
 #include "dim3/triangle_predicates.hpp"
@@ -190,7 +191,7 @@ SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptio
 
 Box<3> SurfaceBoundary::root_box() const {
   const Box<3> b = surface_.bounding_box();
-  const double half = 0.5 * 1.05 * b.extent().maxCoeff() * options_.root_scale;
+  const double half = 0.5 * default_root_side(b) * options_.root_scale;
   Box<3> cube;
   cube.lo = b.center().array() - half + 2.0 * half * options_.root_shift.array();
   cube.hi = b.center().array() + half + 2.0 * half * options_.root_shift.array();

@@ -137,10 +137,11 @@ inline SizedLevel sized_curve(dim2::CurveBoundary& curve, double size) {
 /// mesh2d at `level` (or, with `size` > 0, as the CLI's --size) from the parsed input.
 inline OurRun run_ours_2d(const dim2::CurveBoundary& base, double level, int threads, const fs::path& dir,
                           dim2::ElementKind elements = dim2::ElementKind::Tri, double size = 0.0) {
-  if (size > 0) level = level_for_size<2>(base.bounding_box(), size).level;
+  const SizedLevel sl = size > 0 ? level_for_size<2>(base.bounding_box(), size) : SizedLevel{};
+  if (size > 0) level = sl.level;
   OurRun run = timed_run<2>(dir, threads, [&] {
     dim2::CurveBoundary curve = base;
-    if (size > 0) sized_curve(curve, size);
+    if (size > 0) curve.set_root_scale(sl.root_scale);
     curve.set_global_level(level);
     dim2::Options2d opt;
     opt.level = level;
