@@ -326,5 +326,13 @@ TEST_CASE("mesh3d's warning for lost volume says how thin the parts are against 
   CHECK(w.find("the mesh's volume differs from the surface's by") != std::string::npos);
   CHECK(w.find("of the surface's area lies on parts thinner than two octants (2 x 0.131)") != std::string::npos);
   CHECK(w.find("two octants across that are --size") != std::string::npos);
+  // What that size costs: the interface faces grow as (0.13125 / size)^2 (size = the thinnest
+  // part's half, under 0.01 here: over 170x).
+  const auto at = w.find("the whole surface at that size is about ");
+  REQUIRE(at != std::string::npos);
+  const double growth = std::stod(w.substr(at + std::string("the whole surface at that size is about ").size()));
+  CHECK(growth > 170);
+  CHECK(w.find("x this mesh's " + std::to_string(j["counts"]["interface_triangles"].get<long>()) + " interface faces") !=
+        std::string::npos);
   std::filesystem::remove_all(dir);
 }
