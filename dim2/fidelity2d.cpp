@@ -132,10 +132,8 @@ Fidelity2d measure_fidelity(const FeBeMesh& m, const CurveBoundary& curve, int s
       f.hausdorff = std::max(f.hausdorff, point_segment_distance<2>(p, a, b));
     }
   }
-  for (std::size_t v = 0; v < m.where.size(); ++v) {
-    if (m.where[v].patch < 0) continue;
+  for (const std::int32_t v : m.where.nodes())
     f.max_node_distance = std::max(f.max_node_distance, curve.closest_point(m.mesh.points[v]).distance);
-  }
   f.hausdorff_rel = f.hausdorff / diag;
   f.max_node_distance_rel = f.max_node_distance / diag;
   return f;

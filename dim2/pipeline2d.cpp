@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -140,43 +141,44 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       // ~3e-11 at level 17; real moves near the curve are far above it.
       so.min_move = 1e-10;
       so.fixed.assign(fe.mesh.points.size(), 0);
+      const std::span<const std::int32_t> located = fe.where.nodes();
       if (opt.slide_boundary) {
-        for (std::size_t v = 0; v < fe.where.size(); ++v)
-          if (fe.where[v].kind == BoundaryLocation::Kind::Corner) so.fixed[v] = 1;
+        for (std::size_t k = 0; k < located.size(); ++k)
+          if (fe.where.locations()[k].kind == BoundaryLocation::Kind::Corner) so.fixed[located[k]] = 1;
         so.project = [&](const Point<2>& p) { return Point<2>(curve.closest_point(p).point); };
       } else {
         // The solid's boundary is the BE mesh: its nodes stay, and smooth need not find them.
-        for (std::size_t v = 0; v < fe.where.size(); ++v) so.fixed[v] = fe.where[v].patch >= 0 ? 1 : 0;
+        for (const std::int32_t v : located) so.fixed[v] = 1;
         so.boundary_fixed = true;
       }
       const SmoothStats ss = smooth(fe.mesh, so);
       r.n_smoothing_rejected = ss.moves_rejected;
       if (opt.slide_boundary) {
-        for (std::size_t v = 0; v < fe.where.size(); ++v)
-          if (fe.where[v].patch >= 0 && fe.where[v].kind != BoundaryLocation::Kind::Corner)
-            fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
+        for (std::size_t k = 0; k < located.size(); ++k)
+          if (BoundaryLocation& w = fe.where.locations()[k]; w.kind != BoundaryLocation::Kind::Corner)
+            w = curve.closest_point(fe.mesh.points[located[k]]).where;
       }
       clock.lap("smoothing");
       // Interface nodes slide along their own loop, landing exactly on the curve; corners stay.
       std::vector<std::uint8_t> locked;
       auto lock_interface = [&] {
         locked.assign(fe.mesh.points.size(), 0);
-        for (std::size_t v = 0; v < fe.where.size(); ++v) {
-          if (fe.where[v].patch < 0) continue;
-          locked[v] = fe.where[v].kind == BoundaryLocation::Kind::Corner || !opt.slide_in_quality_pass ? 1 : 2;
-        }
+        for (std::size_t k = 0; k < fe.where.size(); ++k)
+          locked[fe.where.nodes()[k]] =
+              fe.where.locations()[k].kind == BoundaryLocation::Kind::Corner || !opt.slide_in_quality_pass ? 1 : 2;
       };
       const SlideFn slide = [&](std::int32_t v, const Point<2>& target) {
         const ClosestPoint<2> cp = curve.closest_point(target);
-        if (cp.where.patch != fe.where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner)
-          return fe.mesh.points[v];
-        fe.where[v] = cp.where;
+        BoundaryLocation& w = fe.where.at(v);
+        if (cp.where.patch != w.patch || cp.where.kind == BoundaryLocation::Kind::Corner) return fe.mesh.points[v];
+        w = cp.where;
         return Point<2>(cp.point);
       };
       // A rejected slide left `where` at the tried point: recompute it from the kept position.
       auto settle_interface = [&] {
-        for (std::size_t v = 0; v < fe.where.size(); ++v)
-          if (locked[v] == 2) fe.where[v] = curve.closest_point(fe.mesh.points[v]).where;
+        for (std::size_t k = 0; k < fe.where.size(); ++k)
+          if (const std::int32_t v = fe.where.nodes()[k]; locked[v] == 2)
+            fe.where.locations()[k] = curve.closest_point(fe.mesh.points[v]).where;
       };
       if (opt.improve_rounds > 0) {
         say("quality: edge flips and angle-guarded smoothing");

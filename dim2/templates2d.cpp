@@ -46,8 +46,9 @@ struct Builder {
   }
   std::int32_t point(const P2& p, const BoundaryLocation& w = {}) {
     out.mesh.add_point(p);
-    out.where.push_back(w);
-    return static_cast<std::int32_t>(out.mesh.points.size() - 1);
+    const auto id = static_cast<std::int32_t>(out.mesh.points.size() - 1);
+    if (w.patch >= 0) out.where.add(id, w);
+    return id;
   }
   const P2& at(std::int32_t i) const { return out.mesh.points[i]; }
 };
@@ -206,8 +207,7 @@ void interior_templates(FeBeMesh& out, const QuadrantComplex& qc, ElementKind ki
   m.solid.node.resize(total.element_nodes);
   m.level.resize(total.elements);
   m.from_boundary_cell.resize(total.elements);
-  m.points.resize(total.points);
-  out.where.resize(total.points);
+  m.points.resize(total.points);  // (the templates' own points are not on the curve)
   for_each_chunk(n, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     Slots slots{m, start[c].elements, start[c].element_nodes, start[c].points};
     interior_templates(slots, qc, kind, begin, end);
@@ -329,7 +329,6 @@ TemplateCounts count_templates(const QuadrantComplex& qc, ElementKind kind) {
 void reserve(FeBeMesh& out, const TemplateCounts& n) {
   Mesh<2>& m = out.mesh;
   reserve_huge(m.points, n.points);
-  reserve_huge(out.where, n.points);
   reserve_huge(m.solid.type, n.elements);
   reserve_huge(m.solid.offset, n.elements + 1);
   reserve_huge(m.solid.node, n.element_nodes);
@@ -345,9 +344,12 @@ FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidp
   const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
   reserve(b.out, count_templates(qc, base));
   b.out.mesh.points.assign(qc.points.begin(), qc.points.end());
-  b.out.where.resize(qc.points.size());
+  std::size_t n_located = 0;
+  for (const NodeKind k : qc.kind) n_located += k == NodeKind::Boundary ? 1 : 0;
+  b.out.where.reserve(n_located);
   for (std::size_t i = 0; i < qc.points.size(); ++i)
-    if (qc.kind[i] == NodeKind::Boundary) b.out.where[i] = qc.where(static_cast<std::int32_t>(i));
+    if (qc.kind[i] == NodeKind::Boundary && qc.where(static_cast<std::int32_t>(i)).patch >= 0)
+      b.out.where.add(static_cast<std::int32_t>(i), qc.where(static_cast<std::int32_t>(i)));
   interior_templates(b.out, qc, base, n_threads);
   boundary_templates(b, qc, base);
   if (kind == ElementKind::Quad) return split_to_quads(b.out, midpoint);

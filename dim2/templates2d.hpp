@@ -18,6 +18,7 @@
 #include <string>
 
 #include "core/mesh.hpp"
+#include "dim2/curve_locations.hpp"
 #include "dim2/quadrant_complex.hpp"
 
 namespace febemesh::dim2 {
@@ -34,8 +35,8 @@ using CurveMidpoint = std::function<std::pair<Point<2>, BoundaryLocation>(const 
 
 struct FeBeMesh {
   Mesh<2> mesh;
-  /// Per mesh node: its location on the curve for interface nodes (patch < 0 otherwise).
-  std::vector<BoundaryLocation> where;
+  /// The interface nodes' locations on the curve (the other nodes have none: patch < 0).
+  CurveLocations where;
 };
 
 /// Triangles / quads / mixed elements of every quadrant, and the BE edges, sharing nodes.

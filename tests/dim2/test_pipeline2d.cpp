@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -80,6 +81,26 @@ TEST_CASE("mesh2d gives valid FE and BE meshes on the bundled examples", "[pipel
     CHECK(std::abs(out.f.fe_area - out.f.be_polygon_area) <= 1e-10 * out.f.exact_area);
     CHECK(out.f.area_rel_error < 0.05);
     CHECK(out.f.max_node_distance_rel <= 1e-10);
+    // The curve locations (FeBeMesh::where) are the interface nodes', and only theirs: each is
+    // where its node lies on the curve.
+    std::vector<std::int32_t> on_interface;
+    for (const VertexId v : out.r.fe.mesh.interface.node) on_interface.push_back(v.v);
+    std::sort(on_interface.begin(), on_interface.end());
+    on_interface.erase(std::unique(on_interface.begin(), on_interface.end()), on_interface.end());
+    const auto located = out.r.fe.where.nodes();
+    CHECK(std::vector<std::int32_t>(located.begin(), located.end()) == on_interface);
+    {
+      CurveBoundary curve(read_domain(example(c.file)));
+      const Box<2> bb = curve.bounding_box();
+      double worst = 0.0;
+      for (std::size_t k = 0; k < located.size(); ++k) {
+        const BoundaryLocation& w = out.r.fe.where.locations()[k];
+        CHECK(&out.r.fe.where[located[k]] == &w);
+        worst = std::max(worst, (curve.evaluate(w.patch, w.param[0]) - out.r.fe.mesh.points[located[k]]).norm());
+      }
+      CHECK(worst <= 1e-9 * (bb.hi - bb.lo).norm());
+    }
+    CHECK(out.r.fe.where[-1].patch < 0);
     // The quality bar (issue 4): triangles >= 20 deg away from input corners sharper than 20
     // deg; mixed meshes too (their triangles come from the same templates).
     if (c.kind != ElementKind::Quad) CHECK(out.min_angle_bar >= 20.0);

@@ -68,24 +68,24 @@ TEST_CASE("the fast quality pass gives the mesh of its slow twin", "[pipeline2d]
     curve.set_global_level(6);
     Result2d r = run(file, 6, kind, 1, 0);  // the mesh before the quality pass
     std::vector<std::uint8_t> locked(r.fe.mesh.points.size(), 0);
-    for (std::size_t v = 0; v < r.fe.where.size(); ++v)
-      if (r.fe.where[v].patch >= 0) locked[v] = r.fe.where[v].kind == BoundaryLocation::Kind::Corner ? 1 : 2;
+    for (std::size_t k = 0; k < r.fe.where.size(); ++k)
+      locked[r.fe.where.nodes()[k]] = r.fe.where.locations()[k].kind == BoundaryLocation::Kind::Corner ? 1 : 2;
     // The pipeline's slide: along the node's own loop, never onto a corner.
-    auto slide_for = [&](Mesh<2>& m, std::vector<BoundaryLocation>& where) -> SlideFn {
+    auto slide_for = [&](Mesh<2>& m, CurveLocations& where) -> SlideFn {
       return [&m, &where, &curve](std::int32_t v, const Point<2>& target) {
         const ClosestPoint<2> cp = curve.closest_point(target);
-        if (cp.where.patch != where[v].patch || cp.where.kind == BoundaryLocation::Kind::Corner) return m.points[v];
-        where[v] = cp.where;
+        if (cp.where.patch != where.at(v).patch || cp.where.kind == BoundaryLocation::Kind::Corner) return m.points[v];
+        where.at(v) = cp.where;
         return Point<2>(cp.point);
       };
     };
     Mesh<2> slow = r.fe.mesh;
-    std::vector<BoundaryLocation> where_slow = r.fe.where;
+    CurveLocations where_slow = r.fe.where;
     const ImproveStats b = improve_mesh_ref(slow, locked, 4, slide_for(slow, where_slow));
     for (const int threads : {1, 2}) {  // (threads: the set-up and the mesh's smallest angle)
       INFO(threads << " threads");
       Mesh<2> fast = r.fe.mesh;
-      std::vector<BoundaryLocation> where_fast = r.fe.where;
+      CurveLocations where_fast = r.fe.where;
       const ImproveStats a = improve_mesh(fast, locked, 4, slide_for(fast, where_fast), threads);
       CHECK(a.flips == b.flips);
       CHECK(a.moves == b.moves);
