@@ -380,7 +380,7 @@ namespace {
 /// element is not such a tetrahedron (then the general count runs). The nodes in chunks on
 /// n_threads threads, each with its own marks (integer counts: the same sum for every count;
 /// serial, it was 0.12 s of sphere966 L6's 2.9 s on two threads).
-std::optional<long> tet_euler_characteristic(const Mesh<3>& mesh, int n_threads) {
+std::optional<long> tet_euler_characteristic(const Mesh<3>& mesh, int n_threads, std::size_t run_uses) {
   const Elements& els = mesh.solid;
   const std::size_t n = mesh.points.size();
   std::atomic<bool> tets_only{true};
@@ -396,53 +396,67 @@ std::optional<long> tet_euler_characteristic(const Mesh<3>& mesh, int n_threads)
     }
   });
   if (!tets_only.load()) return std::nullopt;
+  // Each node's tetrahedra, listed for runs of nodes holding at most a quarter of the uses (a
+  // pass over the tetrahedra a run): the lists of all nodes at once, 16 B a tetrahedron, were the
+  // 3D pipeline's memory peak (its check before the quality stage, beside the octant complex:
+  // sphere966 at 10^6 tetrahedra, 87 -> 102 MB resident).
+  std::vector<std::int32_t> n_uses(n, 0);
+  for (const VertexId v : els.node) ++n_uses[static_cast<std::size_t>(v.v)];
+  const std::size_t cap = run_uses != 0 ? run_uses : std::max<std::size_t>(els.node.size() / 4, std::size_t(1) << 20);
   std::vector<std::int32_t> start, incident;
-  incidence_csr(
-      n, els.size(),
-      [&](std::size_t e, auto&& f) {
-        const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
-        for (int i = 0; i < 4; ++i) f(v[i].v);
-      },
-      n_threads, start, incident);
   std::atomic<long> total{0};
-  for_each_chunk_balanced(n, std::size_t(1) << 12, n_threads, [&](auto&& next) {
-    std::vector<std::int32_t> mark(n, -1);
-    std::vector<std::uint64_t> pairs;
-    long nv = 0, ne = 0, nf = 0;
-    for (std::size_t begin = 0, end = 0; next(begin, end);)
-      for (std::size_t vi = begin; vi < end; ++vi) {
-        if (start[vi] == start[vi + 1]) continue;
-        const std::int32_t v = static_cast<std::int32_t>(vi);
-        ++nv;
-        pairs.clear();
-        for (std::int32_t k = start[vi]; k < start[vi + 1]; ++k) {
-          const VertexId* t = els.nodes(ElemId{incident[k]});
-          std::array<std::int32_t, 3> o{};
-          int m = 0;
+  for (std::size_t v0 = 0; v0 < n;) {
+    std::size_t v1 = v0 + 1, uses = static_cast<std::size_t>(n_uses[v0]);
+    while (v1 < n && uses + static_cast<std::size_t>(n_uses[v1]) <= cap) uses += static_cast<std::size_t>(n_uses[v1++]);
+    const auto lo = static_cast<std::int32_t>(v0), hi = static_cast<std::int32_t>(v1);
+    incidence_csr(
+        v1 - v0, els.size(),
+        [&](std::size_t e, auto&& f) {
+          const VertexId* v = els.nodes(ElemId{static_cast<std::int32_t>(e)});
           for (int i = 0; i < 4; ++i)
-            if (t[i].v != v) o[m++] = t[i].v;
-          for (const std::int32_t u : o)
-            if (u > v && mark[u] != v) mark[u] = v, ++ne;
-          // The three faces through v: v with two of the other three nodes.
-          for (int i = 0; i < 3; ++i) {
-            const std::int32_t a = o[(i + 1) % 3], b = o[(i + 2) % 3];
-            if (a > v && b > v)
-              pairs.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)));
+            if (v[i].v >= lo && v[i].v < hi) f(v[i].v - lo);
+        },
+        n_threads, start, incident);
+    for_each_chunk_balanced(v1 - v0, std::size_t(1) << 12, n_threads, [&](auto&& next) {
+      std::vector<std::int32_t> mark(n, -1);
+      std::vector<std::uint64_t> pairs;
+      long nv = 0, ne = 0, nf = 0;
+      for (std::size_t begin = 0, end = 0; next(begin, end);)
+        for (std::size_t vi = begin; vi < end; ++vi) {
+          if (start[vi] == start[vi + 1]) continue;
+          const std::int32_t v = lo + static_cast<std::int32_t>(vi);
+          ++nv;
+          pairs.clear();
+          for (std::int32_t k = start[vi]; k < start[vi + 1]; ++k) {
+            const VertexId* t = els.nodes(ElemId{incident[k]});
+            std::array<std::int32_t, 3> o{};
+            int m = 0;
+            for (int i = 0; i < 4; ++i)
+              if (t[i].v != v) o[m++] = t[i].v;
+            for (const std::int32_t u : o)
+              if (u > v && mark[u] != v) mark[u] = v, ++ne;
+            // The three faces through v: v with two of the other three nodes.
+            for (int i = 0; i < 3; ++i) {
+              const std::int32_t a = o[(i + 1) % 3], b = o[(i + 2) % 3];
+              if (a > v && b > v)
+                pairs.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)));
+            }
           }
+          std::sort(pairs.begin(), pairs.end());
+          nf += std::unique(pairs.begin(), pairs.end()) - pairs.begin();
         }
-        std::sort(pairs.begin(), pairs.end());
-        nf += std::unique(pairs.begin(), pairs.end()) - pairs.begin();
-      }
-    total += nv - ne + nf;
-  });
+      total += nv - ne + nf;
+    });
+    v0 = v1;
+  }
   return total.load() - static_cast<long>(els.size());
 }
 
 }  // namespace
 
-template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh, int n_threads) {
+template <int Dim> long euler_characteristic(const Mesh<Dim>& mesh, int n_threads, std::size_t run_uses) {
   if constexpr (Dim == 3) {
-    if (const std::optional<long> x = tet_euler_characteristic(mesh, n_threads)) return *x;
+    if (const std::optional<long> x = tet_euler_characteristic(mesh, n_threads, run_uses)) return *x;
   }
   return euler_characteristic_ref(mesh);
 }
@@ -814,8 +828,8 @@ template std::uint64_t content_hash<2>(const Mesh<2>&);
 template std::uint64_t content_hash<3>(const Mesh<3>&);
 template bool is_valid<2>(const Mesh<2>&, const ValidateOptions<2>&);
 template bool is_valid<3>(const Mesh<3>&, const ValidateOptions<3>&);
-template long euler_characteristic<2>(const Mesh<2>&, int);
-template long euler_characteristic<3>(const Mesh<3>&, int);
+template long euler_characteristic<2>(const Mesh<2>&, int, std::size_t);
+template long euler_characteristic<3>(const Mesh<3>&, int, std::size_t);
 template long euler_characteristic_ref<2>(const Mesh<2>&);
 template long euler_characteristic_ref<3>(const Mesh<3>&);
 

@@ -349,6 +349,9 @@ TEST_CASE("euler_characteristic of tetrahedra agrees with its sorting twin", "[v
     CAPTURE(seed);
     CHECK(euler_characteristic(m) == euler_characteristic_ref(m));
     for (const int threads : {2, 3}) CHECK(euler_characteristic(m, threads) == euler_characteristic_ref(m));
+    // Nodes counted in runs (one node's uses, a few nodes', a quarter of them).
+    for (const std::size_t run : {std::size_t(1), std::size_t(23), m.solid.node.size() / 4 + 1})
+      for (const int threads : {1, 2}) CHECK(euler_characteristic(m, threads, run) == euler_characteristic_ref(m));
   }
   // Large enough (about 74,600 of 82,944 tetrahedra kept) that the node lists are built on
   // several threads too.
@@ -359,6 +362,7 @@ TEST_CASE("euler_characteristic of tetrahedra agrees with its sorting twin", "[v
   });
   const long want = euler_characteristic_ref(big);
   for (const int threads : {1, 2, 3}) CHECK(euler_characteristic(big, threads) == want);
+  for (const int threads : {1, 2}) CHECK(euler_characteristic(big, threads, big.solid.node.size() / 5) == want);
   // A tetrahedron with a repeated node: the general count.
   Mesh<3> bad = kuhn_cube(1, [](std::size_t i) { return i == 0; });
   bad.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{1}, VertexId{1}, VertexId{7}});
