@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <span>
 #include <sstream>
 
 #include "core/error.hpp"
@@ -141,22 +140,21 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
       // ~3e-11 at level 17; real moves near the curve are far above it.
       so.min_move = 1e-10;
       so.fixed.assign(fe.mesh.points.size(), 0);
-      const std::span<const std::int32_t> located = fe.where.nodes();
       if (opt.slide_boundary) {
-        for (std::size_t k = 0; k < located.size(); ++k)
-          if (fe.where.locations()[k].kind == BoundaryLocation::Kind::Corner) so.fixed[located[k]] = 1;
+        for (std::size_t k = 0; k < fe.where.size(); ++k)
+          if (fe.where.locations()[k].kind == BoundaryLocation::Kind::Corner) so.fixed[fe.where.nodes()[k]] = 1;
         so.project = [&](const Point<2>& p) { return Point<2>(curve.closest_point(p).point); };
       } else {
         // The solid's boundary is the BE mesh: its nodes stay, and smooth need not find them.
-        for (const std::int32_t v : located) so.fixed[v] = 1;
+        for (const std::int32_t v : fe.where.nodes()) so.fixed[v] = 1;
         so.boundary_fixed = true;
       }
       const SmoothStats ss = smooth(fe.mesh, so);
       r.n_smoothing_rejected = ss.moves_rejected;
       if (opt.slide_boundary) {
-        for (std::size_t k = 0; k < located.size(); ++k)
+        for (std::size_t k = 0; k < fe.where.size(); ++k)
           if (BoundaryLocation& w = fe.where.locations()[k]; w.kind != BoundaryLocation::Kind::Corner)
-            w = curve.closest_point(fe.mesh.points[located[k]]).where;
+            w = curve.closest_point(fe.mesh.points[fe.where.nodes()[k]]).where;
       }
       clock.lap("smoothing");
       // Interface nodes slide along their own loop, landing exactly on the curve; corners stay.
