@@ -43,13 +43,40 @@ inline void advise_huge_pages(const void* p, std::size_t bytes) {
 #endif
 }
 
+/// Backs the whole pages of [p, p + bytes) now (MADV_POPULATE_WRITE, Linux 5.14; nothing where
+/// the kernel lacks it), in one call instead of a page fault at each page's first write. On this
+/// machine (a guest whose first write to a fresh 4 KiB page is slow) 64 MB written fresh took
+/// 184-196 ms, populated first 12-15 ms + 90-92 ms; bench_mesh2d flange at 10^6 triangles, one
+/// thread, six rounds: 0.680-0.960 s (median 0.73) against 0.780-1.060 s (median 0.93), system
+/// time 0.10-0.15 s against 0.26-0.34 s. Populated pages are resident: only for storage that will
+/// be written.
+inline void populate_pages(const void* p, std::size_t bytes) {
+  constexpr std::uintptr_t page = 4096;
+  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + page - 1) & ~(page - 1);
+  const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(page - 1);
+#ifndef MADV_POPULATE_WRITE
+  constexpr int populate_write = 23;  // (glibc's headers before 2.35)
+#else
+  constexpr int populate_write = MADV_POPULATE_WRITE;
+#endif
+  if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, populate_write);  // advice: errors ignored
+}
+
 /// v.reserve(n), with huge pages on fresh storage of 4 MiB or more (below, the one partly used
-/// huge page at each end would be a visible share of it, as for the tree's leaves). Call it
-/// before the elements are written (assign, resize or push_back after it).
-template <class T, class A> void reserve_huge(std::vector<T, A>& v, std::size_t n) {
+/// huge page at each end would be a visible share of it, as for the tree's leaves), and no
+/// populating: for room that may stay unwritten (an upper bound on the elements).
+template <class T, class A> void reserve_room(std::vector<T, A>& v, std::size_t n) {
   if (v.capacity() >= n) return;
   v.reserve(n);
   if (n * sizeof(T) >= (std::size_t(4) << 20)) advise_huge_pages(v.data(), n * sizeof(T));
+}
+
+/// reserve_room(v, n) for n elements that will all be written (assign, resize, or n push_backs
+/// after it): fresh storage of 1 MiB or more is populated (populate_pages).
+template <class T, class A> void reserve_huge(std::vector<T, A>& v, std::size_t n) {
+  if (v.capacity() >= n) return;
+  reserve_room(v, n);
+  if (n * sizeof(T) >= (std::size_t(1) << 20)) populate_pages(v.data(), n * sizeof(T));
 }
 
 }  // namespace febemesh

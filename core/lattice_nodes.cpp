@@ -142,7 +142,7 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, Hangi
         return k;
       });
   std::vector<std::uint64_t> keys;
-  reserve_huge(keys, t.n_leaves() * n_corners);
+  reserve_huge(keys, run_start.back() * n_corners);
   keys.resize(run_start.back() * n_corners);
   for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     std::uint64_t* out = keys.data() + run_start[c] * n_corners;

@@ -130,7 +130,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
     return t == ElemType::Tri3 || t == ElemType::Quad4 || t == ElemType::Line2;
   });
   if (n_threads <= 1 && two_a_use) {
-    reserve_huge(g.item, 2 * incident.item.size());
+    reserve_room(g.item, 2 * incident.item.size());
     std::vector<std::int32_t> seen(n, -1), uses;
     if (once) uses.assign(n, 0);
     for (std::size_t v = 0; v < n; ++v) {

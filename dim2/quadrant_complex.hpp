@@ -88,9 +88,9 @@ struct QuadrantComplex {
   /// Room for n_lattice lattice nodes and n_boundary boundary nodes (add_node's arrays), on
   /// huge pages where large.
   void reserve_nodes(std::size_t n_lattice, std::size_t n_boundary) {
-    reserve_huge(points, n_lattice + n_boundary);
-    reserve_huge(kind, n_lattice + n_boundary);
-    reserve_huge(where_, n_boundary);
+    reserve_room(points, n_lattice + n_boundary);  // (n_boundary: at most)
+    reserve_room(kind, n_lattice + n_boundary);
+    reserve_room(where_, n_boundary);
   }
 
   /// Lattice nodes (Interior, Chain) first, then Boundary nodes: only these have a location

@@ -281,7 +281,7 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
       r.begin = begin, r.end = end;
       // 12 face triangles an octant without hanging nodes, more with: room for 14 a octant, so
       // that the list seldom grows by doubling (each growth a fresh copy, faulted in page by page).
-      reserve_huge(r.tris, 14 * (end - begin));
+      reserve_room(r.tris, 14 * (end - begin));
       std::vector<Tri> cell_tris;
       std::vector<LP> cell_fans;
       const auto fan_placeholder = [&](const LP& p) {
