@@ -33,6 +33,9 @@
 namespace febemesh::cli {
 namespace {
 
+/// The finest global level --level and --size may ask for (octants of the root's side / 2^9).
+constexpr int finest_level = 9;
+
 /// x as printf's %g (6 significant digits).
 std::string fmt_g(double x) {
   char text[32];
@@ -51,13 +54,13 @@ std::string thin_parts(dim3::SurfaceBoundary& surface, double cell, std::size_t 
   double thinnest = std::numeric_limits<double>::infinity();
   for (const double t : surface.thicknesses())
     if (t > 0) thinnest = std::min(thinnest, t);
-  const double finest = default_root_side(surface.bounding_box()) / 512.0;  // level 9, default cube
+  const double finest = default_root_side(surface.bounding_box()) / std::ldexp(1.0, finest_level);  // default cube
   const double size = thinnest / 2;
   std::ostringstream os;
   os.precision(3);
   os << "; " << 100.0 * share << "% of the surface's area lies on parts thinner than two octants (2 x " << cell
      << "), down to " << thinnest << " thick: two octants across that are --size " << size;
-  if (size < finest) os << ", finer than level 9 allows (" << finest << ")";
+  if (size < finest) os << ", finer than level " << finest_level << " allows (" << finest << ")";
   // --size puts the whole surface at that size: the interface faces grow as the area over the
   // octants' faces. (Measured: rotor.off at --size 0.01, 43x its level-4 interface faces by this
   // rule, had not finished after 15 minutes on one thread.)
@@ -179,7 +182,7 @@ int run(const std::vector<std::string>& argv) {
   const auto out = args.value("-o");
   if (!out) throw UsageError("missing -o DIR");
   dim3::Options3d opt;
-  opt.level = args.int_or("--level", 4, 1, 9);
+  opt.level = args.int_or("--level", 4, 1, finest_level);
   opt.size = size_option(args);
   opt.extra_levels = args.int_or("--extra-levels", 2, 0, 4);
   opt.buffer = args.real_or("--buffer", 0.2, 0.0, 0.5);
@@ -218,7 +221,7 @@ int run(const std::vector<std::string>& argv) {
   progress("reading " + input);
   dim3::SurfaceBoundary surface = dim3::SurfaceBoundary::from_file(input);
   // --level's range for the level --size gives in the given axes (a frame's may differ).
-  if (opt.size > 0) sized_level<3>(surface.bounding_box(), opt.size, 9, input);
+  if (opt.size > 0) sized_level<3>(surface.bounding_box(), opt.size, finest_level, input);
   const double t_read = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   dim3::Result3d r;
