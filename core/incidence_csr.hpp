@@ -34,7 +34,7 @@ void incidence_csr(std::size_t n, std::size_t n_items, const NodesOf& nodes_of, 
         if (static_cast<std::size_t>(v) >= lo && static_cast<std::size_t>(v) < hi) use(k, v);
       });
   };
-  reserve_huge(start, n + 1);
+  reserve_huge(start, n + 1, n_workers);
   start.assign(n + 1, 0);
   for_each_range(n, n_workers, [&](std::size_t lo, std::size_t hi) {
     each_owned(lo, hi, [&](std::size_t, std::int32_t v) { ++start[static_cast<std::size_t>(v)]; });
@@ -43,7 +43,7 @@ void incidence_csr(std::size_t n, std::size_t n_items, const NodesOf& nodes_of, 
   std::int32_t at = 0;
   for (std::size_t v = 0; v < n; ++v) start[v] = at += start[v];
   start[n] = at;
-  reserve_huge(item, static_cast<std::size_t>(at));
+  reserve_huge(item, static_cast<std::size_t>(at), n_workers);
   item.resize(static_cast<std::size_t>(at));
   for_each_range(n, n_workers, [&](std::size_t lo, std::size_t hi) {
     each_owned(lo, hi, [&](std::size_t k, std::int32_t v) {

@@ -142,7 +142,7 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, Hangi
         return k;
       });
   std::vector<std::uint64_t> keys;
-  reserve_huge(keys, run_start.back() * n_corners);
+  reserve_huge(keys, run_start.back() * n_corners, n_threads);
   keys.resize(run_start.back() * n_corners);
   for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     std::uint64_t* out = keys.data() + run_start[c] * n_corners;
@@ -158,13 +158,13 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, Hangi
   }
 
   LatticeNodes<Dim> nodes;
-  reserve_huge(nodes.points, keys.size());
+  reserve_huge(nodes.points, keys.size(), n_threads);
   nodes.points.resize(keys.size());
   for_each_range(keys.size(), n_threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) nodes.points[n] = point_from_key<Dim>(keys[n]);
   });
 
-  reserve_huge(nodes.leaf_corners, t.n_leaves());
+  reserve_huge(nodes.leaf_corners, t.n_leaves(), n_threads);
   nodes.leaf_corners.resize(t.n_leaves());
   for_each_range(n_leaves, n_threads, [&](std::size_t begin, std::size_t end) {
     // Corner k's answer for the previous kept leaf: a hint only (the same answers from any).

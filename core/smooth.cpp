@@ -57,7 +57,7 @@ Csr incident_elements(std::size_t n, const Elements& els, int n_threads = 1) {
 Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std::vector<std::uint8_t>* once = nullptr,
                     int n_threads = 1) {
   Csr g;
-  reserve_huge(g.start, n + 1);
+  reserve_huge(g.start, n + 1, n_threads);
   g.start.assign(n + 1, 0);
   // Calls visit(w) for every edge (v, w) of v's elements, once per edge use ((v, v): twice).
   auto each_use = [&](std::int32_t v, auto&& visit) {
@@ -162,7 +162,7 @@ Csr edge_neighbours(std::size_t n, const Elements& els, const Csr& incident, std
       }
   });
   for (std::size_t v = 0; v < n; ++v) g.start[v + 1] += g.start[v];
-  reserve_huge(g.item, static_cast<std::size_t>(g.start[n]));
+  reserve_huge(g.item, static_cast<std::size_t>(g.start[n]), n_threads);
   g.item.resize(static_cast<std::size_t>(g.start[n]));
   for_each_chunk_balanced(n, chunk, n_threads, [&](auto&& next) {
     std::vector<std::int32_t> seen(n, -1), uses;
@@ -246,8 +246,8 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   // heap peak (flange level 9, massif).
   std::vector<double> scaled;
   std::vector<std::uint8_t> valid;
-  reserve_huge(scaled, mesh.solid.size());
-  reserve_huge(valid, mesh.solid.size());
+  reserve_huge(scaled, mesh.solid.size(), options.n_threads);
+  reserve_huge(valid, mesh.solid.size(), options.n_threads);
   scaled.resize(mesh.solid.size());
   valid.resize(mesh.solid.size());
   auto set_state = [&](std::int32_t e, const std::pair<bool, double>& st) {

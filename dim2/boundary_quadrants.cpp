@@ -237,7 +237,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   for (const LP& p : nodes.points) qc.add_node(position(t, p), NodeKind::Interior);
   // nodes.find on a flat copy of the node keys (a probe reads a key instead of computing one).
   std::vector<std::uint64_t> node_keys;
-  reserve_huge(node_keys, nodes.points.size());
+  reserve_huge(node_keys, nodes.points.size(), opt.n_threads);
   node_keys.resize(nodes.points.size());
   for_each_range(nodes.points.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) node_keys[n] = point_key<2>(nodes.points[n]);
@@ -264,7 +264,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
                                                       in.begin() + static_cast<std::ptrdiff_t>(end),
                                                       [](std::uint8_t f) { return f != 0; }));
       });
-  reserve_huge(qc.interior, run_start.back());
+  reserve_huge(qc.interior, run_start.back(), opt.n_threads);
   qc.interior.resize(run_start.back());
   for_each_chunk(n_leaves, run, opt.n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
     std::array<std::size_t, 4> near{};

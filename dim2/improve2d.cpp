@@ -192,7 +192,7 @@ class LiveIncidence {
   /// flange 1e6).
   void rebuild(const Mesh<2>& m, int n_threads = 1) {
     const std::size_t n = m.points.size();
-    reserve_huge(first_, n + 1);
+    reserve_huge(first_, n + 1, n_threads);
     first_.resize(n + 1);
     const auto owned = [&](std::size_t lo, std::size_t hi, auto&& use) {
       const auto l = static_cast<std::int32_t>(lo), h = static_cast<std::int32_t>(hi);
@@ -216,7 +216,7 @@ class LiveIncidence {
       start += uses + spare;
     }
     first_[n] = start;
-    reserve_huge(elem_, static_cast<std::size_t>(start));
+    reserve_huge(elem_, static_cast<std::size_t>(start), n_threads);
     elem_.resize(static_cast<std::size_t>(start));
     for_each_range(n, n_threads, [&](std::size_t lo, std::size_t hi) {
       for (std::size_t v = lo; v < hi; ++v)  // the spare slots, after the uses
@@ -328,7 +328,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
   // was 8 bytes an element at this stage's memory); every decision below is the one the
   // degrees make (exceeds).
   std::vector<double> cot;
-  reserve_huge(cot, m.solid.size());
+  reserve_huge(cot, m.solid.size(), n_threads);
   cot.resize(m.solid.size());
   for_each_range(m.solid.size(), n_threads, [&](std::size_t begin, std::size_t end) {
     for (std::size_t e = begin; e < end; ++e) cot[e] = element_top_cot(m, e);

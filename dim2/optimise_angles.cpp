@@ -113,7 +113,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
   // clearly above the target (clearly_above: no atan2) holds NaN until a node of it moves: it
   // cannot be the worst of a node below the target, nor of the mesh while one is below.
   std::vector<double> q_elem;
-  reserve_huge(q_elem, n_elems);
+  reserve_huge(q_elem, n_elems, opt.n_threads);
   q_elem.resize(n_elems);
   // Corner angles that keep q above target + a margin (1e-3 deg): triangles at least
   // tri_deg, quad corners within [quad_deg, 180 - quad_deg]; their cotangents' bounds.

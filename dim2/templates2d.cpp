@@ -326,14 +326,14 @@ TemplateCounts count_templates(const QuadrantComplex& qc, ElementKind kind) {
   return n;
 }
 
-void reserve(FeBeMesh& out, const TemplateCounts& n) {
+void reserve(FeBeMesh& out, const TemplateCounts& n, int n_threads) {
   Mesh<2>& m = out.mesh;
-  reserve_huge(m.points, n.points);
-  reserve_huge(m.solid.type, n.elements);
-  reserve_huge(m.solid.offset, n.elements + 1);
-  reserve_huge(m.solid.node, n.element_nodes);
-  reserve_huge(m.level, n.elements);
-  reserve_huge(m.from_boundary_cell, n.elements);
+  reserve_huge(m.points, n.points, n_threads);
+  reserve_huge(m.solid.type, n.elements, n_threads);
+  reserve_huge(m.solid.offset, n.elements + 1, n_threads);
+  reserve_huge(m.solid.node, n.element_nodes, n_threads);
+  reserve_huge(m.level, n.elements, n_threads);
+  reserve_huge(m.from_boundary_cell, n.elements, n_threads);
   m.interface.type.reserve(n.lines);
   m.interface.offset.reserve(n.lines + 1);
   m.interface.node.reserve(2 * n.lines);
@@ -342,7 +342,7 @@ void reserve(FeBeMesh& out, const TemplateCounts& n) {
 FeBeMesh fe_be_mesh(const QuadrantComplex& qc, ElementKind kind, const CurveMidpoint& midpoint, int n_threads) {
   Builder b;
   const ElementKind base = kind == ElementKind::Tri ? ElementKind::Tri : ElementKind::Mixed;
-  reserve(b.out, count_templates(qc, base));
+  reserve(b.out, count_templates(qc, base), n_threads);
   b.out.mesh.points.assign(qc.points.begin(), qc.points.end());
   std::size_t n_located = 0;
   for (const NodeKind k : qc.kind) n_located += k == NodeKind::Boundary ? 1 : 0;

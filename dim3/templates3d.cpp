@@ -447,10 +447,10 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
                 "tetrahedralize: a boundary octant's element is not a tetrahedron");
   const std::size_t n_all_tets = n_int_tets + m.solid.size();
   // v's n_head first values (pass 3 writes them), then what v held: one fresh allocation.
-  const auto after_head = [](auto& v, std::size_t n_head, const auto& fill) {
+  const auto after_head = [&](auto& v, std::size_t n_head, const auto& fill) {
     const auto tail = std::move(v);
     v = {};
-    reserve_huge(v, n_head + tail.size());
+    reserve_huge(v, n_head + tail.size(), n_threads);
     v.assign(n_head, fill);
     v.insert(v.end(), tail.begin(), tail.end());
   };
@@ -460,7 +460,7 @@ TetMesh tetrahedralize(const Orthtree<3>& t, const OctantComplex& oc, const Surf
   after_head(m.from_boundary_cell, n_int_tets, std::uint8_t{0});
   after_head(b.out.cell, n_int_tets, std::int32_t{0});
   m.solid.offset = {};
-  reserve_huge(m.solid.offset, n_all_tets + 1);
+  reserve_huge(m.solid.offset, n_all_tets + 1, n_threads);
   m.solid.offset.resize(n_all_tets + 1);
   if (reuse) {
     const auto n = static_cast<std::ptrdiff_t>(n_int_tets);
