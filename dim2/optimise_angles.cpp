@@ -147,17 +147,40 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
                                   return std::isnan(q_elem[e]) ? inf : q_elem[e];
                                 }));
     if (q <= opt.target || n_elems == 0) return n_elems ? q : 0.0;
-    double top[2];  // triangles, quads
-    for (const int kind : {0, 1})
-      top[kind] = range_max(n_elems, opt.n_threads, [&](std::size_t e) {
-        if (!std::isnan(q_elem[e]) || is_tri(e) != (kind == 0)) return -inf;
-        const double b = badness(e);
-        return std::isfinite(b) ? b : -inf;
-      });
-    return std::min(q, range_min(n_elems, opt.n_threads, [&](std::size_t e) {
-                      if (!std::isnan(q_elem[e])) return inf;
-                      const double b = badness(e), t = top[is_tri(e) ? 0 : 1];
-                      return !std::isfinite(b) || t - b <= 1e-9 * (1.0 + t * t) ? scaled_quality(e) : inf;
+    // Each kind's largest finite badness, and per block of elements its own (and whether one
+    // has none finite), in one pass; then only the blocks that can hold an element to measure
+    // are read again. (Two passes for the two kinds and a third over all elements for the
+    // measured ones were 38 ms at flange 1e6, 90% of the stage's end, on one thread or two.)
+    constexpr std::size_t block = 4096;
+    struct BlockTop {
+      double top[2] = {-inf, -inf};  // triangles, quads
+      bool unbounded = false;        // an element without a finite badness (always measured)
+    };
+    std::vector<BlockTop> blocks((n_elems + block - 1) / block);
+    for_each_range(blocks.size(), opt.n_threads, [&](std::size_t b0, std::size_t b1) {
+      for (std::size_t k = b0; k < b1; ++k)
+        for (std::size_t e = k * block; e < std::min(n_elems, (k + 1) * block); ++e) {
+          if (!std::isnan(q_elem[e])) continue;
+          const double b = badness(e);
+          if (!std::isfinite(b)) blocks[k].unbounded = true;
+          else blocks[k].top[is_tri(e) ? 0 : 1] = std::max(blocks[k].top[is_tri(e) ? 0 : 1], b);
+        }
+    });
+    double top[2] = {-inf, -inf};
+    for (const BlockTop& t : blocks)
+      for (const int kind : {0, 1}) top[kind] = std::max(top[kind], t.top[kind]);
+    const auto near_top = [&](double b, int kind) { return top[kind] - b <= 1e-9 * (1.0 + top[kind] * top[kind]); };
+    std::vector<std::size_t> read;  // an element within rounding of its kind's top lies in one of these
+    for (std::size_t k = 0; k < blocks.size(); ++k)
+      if (blocks[k].unbounded || near_top(blocks[k].top[0], 0) || near_top(blocks[k].top[1], 1)) read.push_back(k);
+    return std::min(q, range_min(read.size(), opt.n_threads, [&](std::size_t i) {
+                      double worst = inf;
+                      for (std::size_t e = read[i] * block; e < std::min(n_elems, (read[i] + 1) * block); ++e) {
+                        if (!std::isnan(q_elem[e])) continue;
+                        const double b = badness(e);
+                        if (!std::isfinite(b) || near_top(b, is_tri(e) ? 0 : 1)) worst = std::min(worst, scaled_quality(e));
+                      }
+                      return worst;
                     }));
   };
   st.worst_before = mesh_worst();

@@ -218,3 +218,49 @@ TEST_CASE("the optimiser never inverts an element nor lowers the worst quality",
     RC_ASSERT(again.points == m.points);
   });
 }
+
+TEST_CASE("the worst quality reported is the mesh's own, read by blocks of elements", "[optimise_angles]") {
+  // 130 x 130 quads (16,900 elements: five blocks of 4096), every node off its grid point by a
+  // smooth field, the quads of rows 60-69 split into two triangles each: every element clearly
+  // above the target, so the worst one is found through the largest badness of its kind.
+  const int n = 130;
+  const Mesh<2> quads = grid(n, [](int i, int j) {
+    return Point<2>(0.06 * std::sin(0.7 * i + 1.3 * j), 0.05 * std::cos(1.1 * i - 0.4 * j));
+  });
+  Mesh<2> m;
+  m.points = quads.points;
+  for (std::size_t e = 0; e < quads.solid.size(); ++e) {
+    const VertexId* v = quads.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const std::size_t row = e / n;
+    if (row >= 60 && row < 70) {
+      m.solid.add(ElemType::Tri3, {v[0], v[1], v[2]});
+      m.solid.add(ElemType::Tri3, {v[0], v[2], v[3]});
+      m.level.insert(m.level.end(), 2, 0);
+      m.from_boundary_cell.insert(m.from_boundary_cell.end(), 2, 0);
+    } else {
+      m.solid.add(ElemType::Quad4, {v[0], v[1], v[2], v[3]});
+      m.level.push_back(0);
+      m.from_boundary_cell.push_back(0);
+    }
+  }
+  const double q0 = worst(m);
+  REQUIRE(q0 > 1.25 * 1.1);  // above the target with room: no node searched
+  for (const int n_threads : {1, 2}) {
+    Mesh<2> work = m;
+    AngleOptimiseOptions ao;
+    ao.n_threads = n_threads;
+    const AngleOptimiseStats st = optimise_angles(work, lock_border(work, n), ao);
+    CHECK(st.moves == 0);
+    CHECK(st.worst_before == q0);  // exactly: the same element's angle_quality
+    CHECK(st.worst_after == q0);
+  }
+  // A quad made the worst, in the third block: found there.
+  Mesh<2> bent = m;
+  bent.points[static_cast<std::size_t>(100 * (n + 1) + 40)] += Point<2>(0.3, 0.3);
+  const double q1 = worst(bent);
+  REQUIRE(q1 < q0);
+  REQUIRE(q1 > 1.25 * 1.1);
+  AngleOptimiseOptions ao;
+  ao.rounds = 0;
+  CHECK(optimise_angles(bent, lock_border(bent, n), ao).worst_before == q1);
+}
