@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <unordered_map>
@@ -326,18 +328,39 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
   }
   res.stats.n_chains = chains.size();
 
-  // Project every chain node (paper eq. 1 with the crossing rule).
-  Projector proj{t, in, curve, opt, res.stats};
+  // Project every chain node (paper eq. 1 with the crossing rule), all chains at once on
+  // opt.n_threads threads (each projection reads only the tree, the flags and the curve; it
+  // was 13 ms of this stage's 110 on two threads at flange 1e6, all on one): chain c's nodes
+  // are projected[first_node[c] + k]. The counts of next normals and walks are summed after.
+  std::vector<std::size_t> first_node(chains.size() + 1, 0);
+  for (std::size_t c = 0; c < chains.size(); ++c) first_node[c + 1] = first_node[c] + chains[c].q.size();
+  std::vector<ClosestPoint<2>> projected(first_node.back());
+  std::vector<std::uint8_t> projected_ok(first_node.back(), 0);
+  std::vector<BoundaryQuadrantStats> projection_stats(static_cast<std::size_t>(std::max(1, opt.n_threads)));
+  std::atomic<std::size_t> next_worker{0};
+  for_each_range(first_node.back(), opt.n_threads, [&](std::size_t i0, std::size_t i1) {
+    Projector proj{t, in, curve, opt, projection_stats[next_worker++]};
+    std::size_t c = static_cast<std::size_t>(std::upper_bound(first_node.begin(), first_node.end(), i0) - first_node.begin()) - 1;
+    for (std::size_t i = i0; i < i1; ++i) {
+      while (i >= first_node[c + 1]) ++c;
+      const std::size_t k = i - first_node[c];
+      projected_ok[i] = proj.project(qc.points[chains[c].q[k]], facet_length(t, facets[chains[c].facet[k]]), projected[i]) ? 1 : 0;
+    }
+  });
+  for (const BoundaryQuadrantStats& ps : projection_stats) {
+    res.stats.n_next_normal += ps.n_next_normal;
+    res.stats.n_walked += ps.n_walked;
+  }
+  const Projector proj{t, in, curve, opt, res.stats};  // (admissible only, below)
   std::vector<int> chains_on_loop(curve.loops().size(), 0);
-  for (const Chain& ch : chains) {
+  for (std::size_t c = 0; c < chains.size(); ++c) {
+    const Chain& ch = chains[c];
     const std::size_t m = ch.q.size();
-    std::vector<ClosestPoint<2>> cp(m);
+    const std::span<const ClosestPoint<2>> cp(projected.data() + first_node[c], m);
     std::vector<double> h(m);
     for (std::size_t k = 0; k < m; ++k) {
       h[k] = facet_length(t, facets[ch.facet[k]]);
-      if (!proj.project(qc.points[ch.q[k]], h[k], cp[k])) {
-        res.problems.push_back({qc.points[ch.q[k]], "no admissible projection onto the curve"});
-      }
+      if (!projected_ok[first_node[c] + k]) res.problems.push_back({qc.points[ch.q[k]], "no admissible projection onto the curve"});
     }
     if (!res.problems.empty()) continue;
 

@@ -55,7 +55,22 @@ TEST_CASE("mesh2d gives the same mesh bytes with 1, 2 and 3 threads", "[pipeline
       const Result2d more = run(c.file, c.level, c.kind, threads);
       CHECK(msh_string(one.fe.mesh) == msh_string(more.fe.mesh));
       CHECK(msh_string(one.fe.mesh, MshEncoding::Binary) == msh_string(more.fe.mesh, MshEncoding::Binary));
+      // The projections run on the threads, their counts summed after.
+      CHECK(one.stats.n_next_normal == more.stats.n_next_normal);
+      CHECK(one.stats.n_walked == more.stats.n_walked);
+      CHECK(one.stats.n_free_edges == more.stats.n_free_edges);
     }
+  }
+  // U0067 at level 5 walks along the curve for some projections and takes a further normal
+  // for one: the counts summed over the threads are the serial ones.
+  const Result2d one = run(glyph("NimbusSans-Regular-U0067.svg"), 5, ElementKind::Tri, 1);
+  REQUIRE(one.stats.n_walked > 0);
+  REQUIRE(one.stats.n_next_normal > 0);
+  for (const int threads : {2, 3}) {
+    const Result2d more = run(glyph("NimbusSans-Regular-U0067.svg"), 5, ElementKind::Tri, threads);
+    CHECK(one.stats.n_walked == more.stats.n_walked);
+    CHECK(one.stats.n_next_normal == more.stats.n_next_normal);
+    CHECK(msh_string(one.fe.mesh) == msh_string(more.fe.mesh));
   }
 }
 
