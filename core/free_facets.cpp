@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/parallel_ranges.hpp"
 
 namespace febemesh {
 
@@ -76,21 +77,37 @@ void leaf_free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const F
 }  // namespace
 
 template <int Dim>
-std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep) {
-  std::vector<FreeFacet<Dim>> out;
-  std::vector<std::size_t> nb;
-  KeptKeys run;
-  std::size_t run_end = 0;  // leaves [.., run_end) are in `run`
-  for (std::size_t i = 0; i < t.n_leaves(); ++i) {
-    if (!keep[i]) continue;
-    if (i >= run_end) {  // a new run of kept leaves without key gaps
-      run.lo = morton_key(t.leaf(i));
-      run.hi = run.lo + volume_units(t.leaf(i));
-      for (run_end = i + 1; run_end < t.n_leaves() && keep[run_end] && morton_key(t.leaf(run_end)) == run.hi; ++run_end)
-        run.hi += volume_units(t.leaf(run_end));
+std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep, int n_threads) {
+  // Runs of leaves on n_threads threads, each with its own list, joined in leaf order (the
+  // serial list: a leaf's facets depend on the tree and the flags only). A chunk starts its
+  // runs of kept keys at its first leaf: a run it cuts short only skips fewer neighbour
+  // searches, which find the same facets. (Serial, this was 11 of the 19 ms the 2D buffer rule
+  // took at flange 1e6, on one thread or two.)
+  const std::size_t n = t.n_leaves();
+  const std::size_t chunk = n_threads <= 1 ? std::max<std::size_t>(n, 1) : chunk_size(n, n_threads, std::size_t(1) << 14);
+  std::vector<std::vector<FreeFacet<Dim>>> parts((n + chunk - 1) / chunk);
+  for_each_chunk(n, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    std::vector<FreeFacet<Dim>>& out = parts[c];
+    std::vector<std::size_t> nb;
+    KeptKeys run;
+    std::size_t run_end = 0;  // leaves [.., run_end) are in `run`
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!keep[i]) continue;
+      if (i >= run_end) {  // a new run of kept leaves without key gaps
+        run.lo = morton_key(t.leaf(i));
+        run.hi = run.lo + volume_units(t.leaf(i));
+        for (run_end = i + 1; run_end < n && keep[run_end] && morton_key(t.leaf(run_end)) == run.hi; ++run_end)
+          run.hi += volume_units(t.leaf(run_end));
+      }
+      leaf_free_facets(t, keys, keep, i, nb, out, run);
     }
-    leaf_free_facets(t, keys, keep, i, nb, out, run);
-  }
+  });
+  if (parts.size() == 1) return std::move(parts[0]);
+  std::size_t total = 0;
+  for (const auto& part : parts) total += part.size();
+  std::vector<FreeFacet<Dim>> out;
+  out.reserve(total);
+  for (const auto& part : parts) out.insert(out.end(), part.begin(), part.end());
   return out;
 }
 
@@ -242,8 +259,8 @@ template struct FreeFacet<2>;
 template struct FreeFacet<3>;
 template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const Flags&);
 template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const Flags&);
-template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const LeafKeys<2>&, const Flags&);
-template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, const Flags&);
+template std::vector<FreeFacet<2>> free_facets<2>(const Orthtree<2>&, const LeafKeys<2>&, const Flags&, int);
+template std::vector<FreeFacet<3>> free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, const Flags&, int);
 template void update_free_facets<2>(const Orthtree<2>&, const LeafKeys<2>&, const Flags&, const std::vector<std::size_t>&,
                                     std::vector<FreeFacet<2>>&);
 template void update_free_facets<3>(const Orthtree<3>&, const LeafKeys<3>&, const Flags&, const std::vector<std::size_t>&,

@@ -24,9 +24,11 @@ template <int Dim> struct FreeFacet {
 /// All free facets of the kept leaves (keep[i] != 0), in leaf order then facet order.
 /// Requires a 2:1 face-balanced tree.
 template <int Dim> std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const Flags& keep);
-/// The same, with the tree's leaf keys already built.
+/// The same, with the tree's leaf keys already built, on n_threads threads (the same list for
+/// every count).
 template <int Dim>
-std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep);
+std::vector<FreeFacet<Dim>> free_facets(const Orthtree<Dim>& t, const LeafKeys<Dim>& keys, const Flags& keep,
+                                        int n_threads = 1);
 
 /// Turns `facets` = free_facets(t, keep before) into free_facets(t, keep) when keep differs
 /// only at the leaves `changed` (any order, repeats allowed): only those leaves and their face

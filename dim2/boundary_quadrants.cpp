@@ -165,13 +165,13 @@ std::size_t remove_pinches(const Orthtree<2>& t, Flags& in, FreeEdges* edges, co
 std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& curve, double fraction,
                          FreeEdges* edges, const LeafKeys<2>* given_keys, int n_threads) {
   if (fraction <= 0) {
-    if (edges) *edges = given_keys ? free_facets(t, *given_keys, in) : free_facets(t, in);
+    if (edges) *edges = given_keys ? free_facets(t, *given_keys, in, n_threads) : free_facets(t, LeafKeys<2>(t), in, n_threads);
     return 0;
   }
   std::optional<LeafKeys<2>> own_keys;
   const LeafKeys<2>& keys = given_keys ? *given_keys : own_keys.emplace(t);
   std::size_t removed = 0;
-  FreeEdges facets = free_facets(t, keys, in);
+  FreeEdges facets = free_facets(t, keys, in, n_threads);
   // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
   // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
   // names its edge: edges of different lengths or axes never share one. The facets in one

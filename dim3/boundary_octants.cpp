@@ -137,7 +137,7 @@ std::size_t remove_pinches(const Orthtree<3>& t, Flags& in, int n_threads) {
   // The free facets once, then only around the octants each pass drops (update_free_facets:
   // the same list; every pass built them and the keys anew, a serial second of elephant L4's
   // two-thread run).
-  std::vector<FreeFacet<3>> facets = free_facets(t, keys, in);
+  std::vector<FreeFacet<3>> facets = free_facets(t, keys, in, n_threads);
   for (int pass = 0; pass < 64; ++pass) {
     const auto points = facet_corners(facets);
     const std::vector<std::size_t> to_drop = drops_at(points, n_threads, [&](const LP& p, std::vector<std::size_t>& drop) {
@@ -283,7 +283,7 @@ std::size_t apply_buffer(const Orthtree<3>& t, Flags& in, const SurfaceBoundary&
   if (fraction <= 0) return 0;
   std::size_t removed = 0;
   for (int pass = 0; pass < 4; ++pass) {
-    const std::vector<FreeFacet<3>> facets = free_facets(t, in);
+    const std::vector<FreeFacet<3>> facets = free_facets(t, LeafKeys<3>(t), in, n_threads);
     std::vector<std::uint8_t> near(facets.size(), 0);
     for_each_range(facets.size(), n_threads, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
@@ -735,7 +735,7 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
   OctantComplexResult res;
   OctantComplex& oc = res.complex;
   oc.lattice = lattice_nodes(t, &in, HangingFlags::Computed, opt.n_threads);
-  const std::vector<FreeFacet<3>> facets = free_facets(t, in);
+  const std::vector<FreeFacet<3>> facets = free_facets(t, LeafKeys<3>(t), in, opt.n_threads);
   // A sub-face left by an unkept finer neighbour may have corners that are no kept octant's
   // corner (the middle of a coarse edge): they become nodes too, so that the faces around them
   // (templates, boundary octants) all see them.

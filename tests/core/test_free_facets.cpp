@@ -133,3 +133,31 @@ TEMPLATE_TEST_CASE_SIG("cells_along_kept: the run along the kept leaves in leaf 
   b[0] = 0.9;
   CHECK(cells_along_kept(t, keep, a, b, 0.05) == Approx(0.05));
 }
+
+TEMPLATE_TEST_CASE_SIG("free_facets gives the same list on any thread count", "[free_facets]", ((int Dim), Dim), 2, 3) {
+  // Enough leaves for several runs of 2^14 on two threads (65,536 in 2D, 32,768 + in 3D), the
+  // leaves near a corner refined once more and the tree balanced; kept: a ball whose runs of
+  // kept keys cross the runs' ends, with some leaves dropped inside.
+  Orthtree<Dim> t;
+  for (int k = 0; k < (Dim == 2 ? 8 : 5); ++k) t = refine(t, Flags(t.n_leaves(), 1));
+  Flags finer(t.n_leaves(), 0);
+  for (std::size_t i = 0; i < t.n_leaves(); ++i) finer[i] = geometry(t, t.leaf(i)).center().norm() < 0.3 ? 1 : 0;
+  t = balance_2to1(refine(t, finer));
+  REQUIRE(t.n_leaves() > (std::size_t(1) << 15));
+  Flags keep(t.n_leaves());
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    keep[i] = (geometry(t, t.leaf(i)).center() - Point<Dim>::Constant(0.45)).norm() < 0.4 && test::mix64(i) % 100 < 98;
+  const LeafKeys<Dim> keys(t);
+  const std::vector<FreeFacet<Dim>> one = free_facets(t, keys, keep, 1);
+  REQUIRE(one.size() > 100);
+  // Against every kept leaf's facets searched (no runs at all).
+  std::vector<std::size_t> all(t.n_leaves());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  std::vector<FreeFacet<Dim>> searched;
+  update_free_facets(t, keys, keep, all, searched);
+  CHECK(same<Dim>(one, searched));
+  for (const int n_threads : {2, 3, 8}) {
+    INFO(n_threads << " threads");
+    CHECK(same<Dim>(free_facets(t, keys, keep, n_threads), one));
+  }
+}
