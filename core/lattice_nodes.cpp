@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 
 #include "core/error.hpp"
 #include "core/huge_pages.hpp"
@@ -69,6 +70,108 @@ void radix_sort(std::vector<std::uint64_t>& keys, int n_threads) {
         std::lower_bound(start.begin(), start.begin() + 256, p * keys.size() / n_parts) - start.begin());
   for_each_range(n_parts, n_threads, [&](std::size_t p0, std::size_t p1) {
     for (std::size_t b = part_first[p0]; b < part_first[p1]; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
+  });
+}
+
+/// The nodes and every kept leaf's corner nodes from one sort: each corner key packed with its
+/// place (leaf * n_corners + corner) below it, sorted, then read in order (a new key, a new
+/// node). The same nodes and corners as sorting the keys alone and searching each corner
+/// among them (that search was 25 of lattice_nodes' 98 ms at flange 1e6, one thread). `keys`
+/// holds the kept leaves' corner keys in leaf order; it is overwritten. False, and nothing
+/// done, when a key's varying bits and the place do not fit in 64 bits together.
+template <int Dim, class Kept>
+bool sort_with_corners(const Orthtree<Dim>& t, const Kept& kept, std::size_t run, const std::vector<std::size_t>& run_start,
+                       std::vector<std::uint64_t>& keys, LatticeNodes<Dim>& nodes, int n_threads) {
+  constexpr int n_corners = Cube<Dim>::n_corners;
+  const std::size_t n_leaves = t.n_leaves();
+  if (keys.empty()) {
+    for (auto& row : nodes.leaf_corners) row.fill(-1);
+    return true;
+  }
+  std::uint64_t any = 0, all = ~std::uint64_t{0};
+  for (const std::uint64_t k : keys) any |= k, all &= k;
+  const std::uint64_t varying = any ^ all;  // outside these bits every key has all's bits
+  const int low = varying == 0 ? 0 : std::countr_zero(varying);
+  const int width = varying == 0 ? 0 : 64 - std::countl_zero(varying) - low;
+  const int place_bits = std::bit_width(n_leaves * n_corners - 1);
+  if (width + place_bits > 64) return false;
+  const std::uint64_t place_mask = place_bits == 64 ? ~std::uint64_t{0} : (std::uint64_t(1) << place_bits) - 1;
+  const std::uint64_t part_mask = width == 64 ? ~std::uint64_t{0} : (std::uint64_t(1) << width) - 1;
+  // Pack in place: run c of leaves (as the keys were written) holds its kept leaves' corners
+  // from run_start[c] * n_corners on, in leaf order.
+  for_each_chunk(n_leaves, run, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    std::uint64_t* at = keys.data() + run_start[c] * n_corners;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!kept(i)) {
+        nodes.leaf_corners[i].fill(-1);
+        continue;
+      }
+      for (int k = 0; k < n_corners; ++k, ++at)
+        *at = (((*at >> low) & part_mask) << place_bits) | static_cast<std::uint64_t>(i * n_corners + static_cast<std::size_t>(k));
+    }
+  });
+  radix_sort(keys, n_threads);
+  // Node ids in key order: a chunk's first node id is the count of distinct keys before it.
+  const std::size_t n_keys = keys.size();
+  const std::size_t chunk = chunk_size(n_keys, n_threads, std::size_t(1) << 16);
+  const auto starts_node = [&](std::size_t j) { return j == 0 || (keys[j] >> place_bits) != (keys[j - 1] >> place_bits); };
+  const std::vector<std::size_t> first_id =
+      chunk_starts(n_keys, chunk, n_threads, std::size_t{0}, [&](std::size_t begin, std::size_t end) {
+        std::size_t k = 0;
+        for (std::size_t j = begin; j < end; ++j) k += starts_node(j) ? 1 : 0;
+        return k;
+      });
+  const std::size_t n_nodes = first_id.back();
+  if (n_nodes > std::size_t(std::numeric_limits<std::int32_t>::max()))
+    throw LimitError("lattice_nodes: " + std::to_string(n_nodes) + " nodes exceed 32-bit node ids");
+  reserve_huge(nodes.points, n_nodes, n_threads);
+  nodes.points.resize(n_nodes);
+  const std::uint64_t fixed = all & ~(part_mask << low);
+  for_each_chunk(n_keys, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    std::size_t id = first_id[c];  // the id of the next new key
+    for (std::size_t j = begin; j < end; ++j) {
+      if (starts_node(j)) nodes.points[id++] = point_from_key<Dim>(fixed | ((keys[j] >> place_bits) << low));
+      const std::uint64_t place = keys[j] & place_mask;
+      nodes.leaf_corners[place / n_corners][place % n_corners] = static_cast<std::int32_t>(id - 1);
+    }
+  });
+  return true;
+}
+
+/// The nodes by sorting the corner keys alone, and each kept leaf's corners by searching them
+/// (sort_with_corners' fallback). `keys` as there; it is left as the sorted distinct keys.
+template <int Dim, class Kept>
+void sort_then_search(const Orthtree<Dim>& t, const Kept& kept, std::vector<std::uint64_t>& keys, LatticeNodes<Dim>& nodes,
+                      int n_threads) {
+  constexpr int n_corners = Cube<Dim>::n_corners;
+  const std::size_t n_leaves = t.n_leaves();
+  radix_sort(keys, n_threads);
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
+    throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
+  }
+
+  reserve_huge(nodes.points, keys.size(), n_threads);
+  nodes.points.resize(keys.size());
+  for_each_range(keys.size(), n_threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) nodes.points[n] = point_from_key<Dim>(keys[n]);
+  });
+
+  for_each_range(n_leaves, n_threads, [&](std::size_t begin, std::size_t end) {
+    // Corner k's answer for the previous kept leaf: a hint only (the same answers from any).
+    std::array<std::size_t, n_corners> near{};
+    for (std::size_t i = begin; i < end; ++i) {
+      auto& row = nodes.leaf_corners[i];
+      if (!kept(i)) {
+        row.fill(-1);
+        continue;
+      }
+      const auto corner_key = corner_keys(t.leaf(i));
+      for (int k = 0; k < n_corners; ++k) {
+        near[k] = lower_bound_from(keys, corner_key[k], near[k]);
+        row[k] = std::int32_t(near[k]);
+      }
+    }
   });
 }
 
@@ -151,44 +254,16 @@ LatticeNodes<Dim> lattice_nodes(const Orthtree<Dim>& t, const Flags* keep, Hangi
       for (const std::uint64_t key : corner_keys(t.leaf(i))) *out++ = key;
     }
   });
-  radix_sort(keys, n_threads);
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
-    throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
-  }
-
   LatticeNodes<Dim> nodes;
-  reserve_huge(nodes.points, keys.size(), n_threads);
-  nodes.points.resize(keys.size());
-  for_each_range(keys.size(), n_threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t n = begin; n < end; ++n) nodes.points[n] = point_from_key<Dim>(keys[n]);
-  });
-
   reserve_huge(nodes.leaf_corners, t.n_leaves(), n_threads);
   nodes.leaf_corners.resize(t.n_leaves());
-  for_each_range(n_leaves, n_threads, [&](std::size_t begin, std::size_t end) {
-    // Corner k's answer for the previous kept leaf: a hint only (the same answers from any).
-    std::array<std::size_t, n_corners> near{};
-    for (std::size_t i = begin; i < end; ++i) {
-      auto& row = nodes.leaf_corners[i];
-      if (!kept(i)) {
-        row.fill(-1);
-        continue;
-      }
-      const auto corner_key = corner_keys(t.leaf(i));
-      for (int k = 0; k < n_corners; ++k) {
-        near[k] = lower_bound_from(keys, corner_key[k], near[k]);
-        row[k] = std::int32_t(near[k]);
-      }
-    }
-  });
-
+  if (!sort_with_corners<Dim>(t, kept, run, run_start, keys, nodes, n_threads)) sort_then_search<Dim>(t, kept, keys, nodes, n_threads);
   if (hanging == HangingFlags::Skipped) return nodes;
   // The leaves touching node p are those containing the 2^Dim finest lattice cells around p.
   const LeafKeys<Dim> leaf_keys(t);
   // Nodes come in Morton order, so each of the 2^Dim cells around them moves little in the
   // leaves' Morton order from one node to the next: its search starts at its previous answer.
-  nodes.hanging.assign(keys.size(), 0);
+  nodes.hanging.assign(nodes.points.size(), 0);
   for_each_range(nodes.points.size(), n_threads, [&](std::size_t begin, std::size_t end) {
     std::array<std::size_t, n_corners> hint{};  // hints only: the same leaves from any
     for (std::size_t n = begin; n < end; ++n) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "core/lattice_nodes.hpp"
 #include "core/orthtree.hpp"
@@ -38,4 +40,61 @@ TEMPLATE_TEST_CASE_SIG("lattice_nodes without hanging flags: the same nodes and 
   CHECK(lean.hanging.empty());
   CHECK(lean.points == full.points);
   CHECK(lean.leaf_corners == full.leaf_corners);
+}
+
+namespace {
+
+/// The kept leaves' corners sorted by key, once each, and each corner's index among them: what
+/// lattice_nodes must give (the slow twin).
+template <int Dim>
+std::pair<std::vector<LatticePoint<Dim>>, std::vector<std::array<std::int32_t, Cube<Dim>::n_corners>>> nodes_by_brute_force(
+    const Orthtree<Dim>& t, const Flags& keep) {
+  std::vector<std::uint64_t> keys;
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    if (keep[i])
+      for (int k = 0; k < Cube<Dim>::n_corners; ++k) keys.push_back(point_key<Dim>(corner(t.leaf(i), k)));
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<LatticePoint<Dim>> points;
+  for (const std::uint64_t k : keys) points.push_back(point_from_key<Dim>(k));
+  std::vector<std::array<std::int32_t, Cube<Dim>::n_corners>> corners(t.n_leaves());
+  for (std::size_t i = 0; i < t.n_leaves(); ++i)
+    for (int k = 0; k < Cube<Dim>::n_corners; ++k)
+      corners[i][k] = keep[i] ? static_cast<std::int32_t>(std::lower_bound(keys.begin(), keys.end(), point_key<Dim>(corner(t.leaf(i), k))) - keys.begin())
+                              : -1;
+  return {points, corners};
+}
+
+}  // namespace
+
+TEMPLATE_TEST_CASE_SIG("lattice_nodes: the kept corners sorted by key, on any thread count", "[nodes]", ((int Dim), Dim), 2, 3) {
+  // A wide tree (the corner keys sorted with their places packed below them: over 2^16 keys,
+  // so several runs on the threads) and one refined to the finest level at a corner (keys too
+  // wide for the places: sorted alone, then searched).
+  RefineOptions wide;
+  wide.max_level = Dim == 2 ? 8 : 6;
+  const auto a = balance_2to1(refine_while<Dim>(
+      Orthtree<Dim>(), [](const Cell<Dim>& c) { return c.level < (Dim == 2 ? 7 : 5) || c.anchor[1] == 0; }, wide));
+  const auto b = balance_2to1(refine_while<Dim>(Orthtree<Dim>(), [](const Cell<Dim>& c) {
+    bool at_origin = true;
+    for (int d = 0; d < Dim; ++d) at_origin = at_origin && c.anchor[d] == 0;
+    return c.level < 2 || at_origin;
+  }));
+  REQUIRE(a.n_leaves() * Cube<Dim>::n_corners > (std::size_t(1) << 16));
+  REQUIRE(b.leaf(0).level == max_level<Dim>);
+  for (const Orthtree<Dim>* t : {&a, &b}) {
+    Flags keep(t->n_leaves());
+    for (std::size_t i = 0; i < t->n_leaves(); ++i) keep[i] = i % 5 != 2;
+    const auto [points, corners] = nodes_by_brute_force(*t, keep);
+    for (const int threads : {1, 2, 3}) {
+      INFO(t->n_leaves() << " leaves, " << threads << " threads");
+      const LatticeNodes<Dim> lean = lattice_nodes(*t, &keep, HangingFlags::Skipped, threads);
+      CHECK(lean.points == points);
+      CHECK(lean.leaf_corners == corners);
+      const LatticeNodes<Dim> full = lattice_nodes(*t, &keep, HangingFlags::Computed, threads);
+      CHECK(full.points == points);
+      CHECK(full.leaf_corners == corners);
+      CHECK(full.hanging.size() == points.size());
+    }
+  }
 }
