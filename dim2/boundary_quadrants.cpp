@@ -177,7 +177,10 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
   // names its edge: edges of different lengths or axes never share one. The facets in one
   // range a thread, each range with caches of its own (a facet's verdict depends on its
   // distances only: the same drops for every count; the first pass was 0.08 s of the 2D
-  // classify stage at flange 1e6, serial).
+  // classify stage at flange 1e6, serial). But for_each_range runs fewer than two items a
+  // worker on one thread, so on two threads these two ranges run one after the other (4 ms at
+  // flange 1e6, session 39); four ranges a thread were slower (10 ms): the unordered_maps
+  // allocate each entry, from the one malloc arena, on both threads at once.
   const std::size_t n_ranges = static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
   struct Caches {
     std::unordered_map<std::uint64_t, double> corner_distance, midpoint_distance;
