@@ -132,6 +132,28 @@ TEST_CASE("pipeline is deterministic and its MSH reads back the same", "[propert
   tally.print("determinism");
 }
 
+TEST_CASE("threads give the one-thread mesh on random domains", "[property][pipeline2d][threads]") {
+  // The flip decisions, the chain projections, the node lists and the free facets run on the
+  // threads (session 39); 2 and 3 threads (ranges of unequal sizes) against one, every kind.
+  Tally tally;
+  test::prop("the same msh bytes and counts on 1, 2 and 3 threads", 6, [&] {
+    const PipelineCase c = *test::gen_pipeline_case();
+    const test::PipelineOutcome one = run_case(c, tally);
+    for (const int threads : {2, 3}) {
+      CurveBoundary curve(test::to_domain(c.domain));
+      Options2d opt = test::to_options(c);
+      opt.n_threads = threads;
+      if (opt.level != no_level) curve.set_global_level(opt.level);
+      const Result2d more = mesh2d(curve, opt);
+      RC_ASSERT(msh_string<2>(one.r.fe.mesh) == msh_string<2>(more.fe.mesh));
+      RC_ASSERT(one.r.stats.n_next_normal == more.stats.n_next_normal);
+      RC_ASSERT(one.r.stats.n_walked == more.stats.n_walked);
+      RC_ASSERT(one.r.n_flips == more.n_flips);
+    }
+  });
+  tally.print("threads");
+}
+
 TEST_CASE("leaving the outside unsplit gives the same mesh, from fewer quadrants", "[property][pipeline2d]") {
   Tally tally;
   test::prop("outside boxes unsplit: the same msh bytes", 4, [&] {
