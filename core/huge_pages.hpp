@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include <sys/mman.h>
@@ -26,11 +27,17 @@ inline bool huge_pages_wanted() {
   return wanted;
 }
 
-/// madvise(advice) on the part of [p, p + bytes) aligned to `align` (a power of two) at both
-/// ends, where there is one. Advice only: errors are ignored.
+/// The part [lo, hi) of [p, p + bytes) aligned to `align` (a power of two) at both ends; empty
+/// (hi <= lo) where there is none.
+inline std::pair<std::uintptr_t, std::uintptr_t> aligned_part(const void* p, std::size_t bytes, std::uintptr_t align) {
+  return {(reinterpret_cast<std::uintptr_t>(p) + align - 1) & ~(align - 1),
+          (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(align - 1)};
+}
+
+/// madvise(advice) on the aligned part of [p, p + bytes) (aligned_part), where there is one.
+/// Advice only: errors are ignored.
 inline void advise_aligned(const void* p, std::size_t bytes, std::uintptr_t align, int advice) {
-  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + align - 1) & ~(align - 1);
-  const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(align - 1);
+  const auto [lo, hi] = aligned_part(p, bytes, align);
   if (hi > lo) madvise(reinterpret_cast<void*>(lo), hi - lo, advice);
 }
 
@@ -84,8 +91,7 @@ template <class T, class A> void reserve_room(std::vector<T, A>& v, std::size_t 
 /// are storage no object lives in yet (the caller constructs its elements after this).
 inline void touch_pages(void* p, std::size_t bytes, int n_threads) {
   constexpr std::size_t page = 4096;
-  const std::uintptr_t lo = (reinterpret_cast<std::uintptr_t>(p) + page - 1) & ~(page - 1);
-  const std::uintptr_t hi = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(page - 1);
+  const auto [lo, hi] = aligned_part(p, bytes, page);
   if (hi <= lo) return;
   for_each_range((hi - lo) / page, n_threads, [&](std::size_t begin, std::size_t end) {
     auto* first = reinterpret_cast<unsigned char*>(lo + begin * page);

@@ -55,6 +55,15 @@ test::PipelineOutcome run_case(const PipelineCase& c, Tally& tally, double root_
   }
 }
 
+/// The case's domain meshed with its options changed by tweak(Options2d&), without the checks.
+template <class Tweak> Result2d mesh_with(const PipelineCase& c, Tweak&& tweak) {
+  CurveBoundary curve(test::to_domain(c.domain));
+  Options2d opt = test::to_options(c);
+  tweak(opt);
+  if (opt.level != no_level) curve.set_global_level(opt.level);
+  return mesh2d(curve, opt);
+}
+
 /// The validity contract on one output.
 void check_valid(const test::PipelineOutcome& out) {
   RC_TAG(out.v.valid ? "valid" : "INVALID");
@@ -140,11 +149,7 @@ TEST_CASE("threads give the one-thread mesh on random domains", "[property][pipe
     const PipelineCase c = *test::gen_pipeline_case();
     const test::PipelineOutcome one = run_case(c, tally);
     for (const int threads : {2, 3}) {
-      CurveBoundary curve(test::to_domain(c.domain));
-      Options2d opt = test::to_options(c);
-      opt.n_threads = threads;
-      if (opt.level != no_level) curve.set_global_level(opt.level);
-      const Result2d more = mesh2d(curve, opt);
+      const Result2d more = mesh_with(c, [&](Options2d& opt) { opt.n_threads = threads; });
       RC_ASSERT(msh_string<2>(one.r.fe.mesh) == msh_string<2>(more.fe.mesh));
       RC_ASSERT(one.r.stats.n_next_normal == more.stats.n_next_normal);
       RC_ASSERT(one.r.stats.n_walked == more.stats.n_walked);
@@ -159,11 +164,7 @@ TEST_CASE("leaving the outside unsplit gives the same mesh, from fewer quadrants
   test::prop("outside boxes unsplit: the same msh bytes", 4, [&] {
     PipelineCase c = *test::gen_pipeline_case();
     const test::PipelineOutcome pruned = run_case(c, tally);
-    CurveBoundary curve(test::to_domain(c.domain));
-    Options2d opt = test::to_options(c);
-    opt.split_outside = true;
-    if (opt.level != no_level) curve.set_global_level(opt.level);
-    const Result2d full = mesh2d(curve, opt);
+    const Result2d full = mesh_with(c, [](Options2d& opt) { opt.split_outside = true; });
     RC_ASSERT(msh_string<2>(pruned.r.fe.mesh) == msh_string<2>(full.fe.mesh));
     RC_ASSERT(pruned.r.tree.n_leaves() <= full.tree.n_leaves());
     RC_TAG(pruned.r.tree.n_leaves() < full.tree.n_leaves() ? "fewer quadrants" : "as many quadrants");
