@@ -218,18 +218,25 @@ template <int Dim> Box<Dim> inflated_box(std::initializer_list<Point<Dim>> corne
 
 
 /// facet_uses(solid) grouped by key: the groups in key order, each group's uses in (element,
-/// local facet) order, the same as facet_uses gives them. A solid of tetrahedra is held at 4
-/// bytes a use: the uses bucketed by the key's smallest node, each an element and local facet
-/// (element << 2 | facet), ordered within the bucket by the rest of the key, which is made again
-/// from the element when needed. facet_uses' 24 bytes a use (96 a tetrahedron) were the CLI's
-/// memory peak in the validation (sphere966 level 6), and the keys stored beside the uses (12
-/// bytes a use) were still its peak in session 35 (72 MB of 163 MB at 1.5 M tetrahedra).
+/// local facet) order, the same as facet_uses gives them. A solid of tetrahedra, or of triangles
+/// and quads (whose facets are their edges (k, k+1)), is held at 4 bytes a use: the uses bucketed
+/// by the key's smallest node, each an element and local facet (element << 2 | facet), ordered
+/// within the bucket by the rest of the key, which is made again from the element when needed.
+/// facet_uses' 24 bytes a use (96 a tetrahedron) were the CLI's memory peak in the validation
+/// (sphere966 level 6), and the keys stored beside the uses (12 bytes a use) were still its peak
+/// in session 35 (72 MB of 163 MB at 1.5 M tetrahedra). For triangles facet_uses' sort was 0.24
+/// s of the 2D validation's 0.44 (flange at 968,326 triangles, one thread; 70 MB).
+/// `bucketed` false: facet_uses for every solid (the slow twin, ValidateOptions::bucketed_facets).
 class FacetGroups {
  public:
-  FacetGroups(const Elements& els, int n_threads) : els_(els) {
-    tets_ = els.size() < (std::size_t(1) << 29) &&
-            std::all_of(els.type.begin(), els.type.end(), [](ElemType t) { return t == ElemType::Tet4; });
-    if (!tets_) {
+  FacetGroups(const Elements& els, int n_threads, bool bucketed = true) : els_(els) {
+    const bool small = els.size() < (std::size_t(1) << 29);
+    tets_ = small && std::all_of(els.type.begin(), els.type.end(), [](ElemType t) { return t == ElemType::Tet4; });
+    polygons_ = small && !els.empty() && std::all_of(els.type.begin(), els.type.end(), [](ElemType t) {
+                  return t == ElemType::Tri3 || t == ElemType::Quad4;
+                });
+    if (!bucketed) tets_ = polygons_ = false;
+    if (!tets_ && !polygons_) {
       uses_ = facet_uses(els);
       for (std::size_t i = 0; i < uses_.size(); ++i) n_groups_ += i == 0 || uses_[i].key != uses_[i - 1].key;
       return;
@@ -238,11 +245,13 @@ class FacetGroups {
     for (const VertexId v : els.node) top = std::max(top, v.v);
     start_.assign(static_cast<std::size_t>(top) + 2, 0);
     const auto each_use = [&](auto&& visit) {
-      for (std::size_t e = 0; e < els.size(); ++e)
-        for (std::uint32_t f = 0; f < 4; ++f) {
+      for (std::size_t e = 0; e < els.size(); ++e) {
+        const auto n = static_cast<std::uint32_t>(tets_ ? 4 : els.offset[e + 1] - els.offset[e]);
+        for (std::uint32_t f = 0; f < n; ++f) {
           const std::uint32_t id = static_cast<std::uint32_t>(e << 2) | f;
           visit(key_of_use(id)[0], id);
         }
+      }
     };
     each_use([&](std::int32_t a, std::uint32_t) { ++start_[static_cast<std::size_t>(a) + 1]; });
     for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
@@ -273,10 +282,13 @@ class FacetGroups {
   }
 
   std::size_t n_groups() const { return n_groups_; }
+  /// Whether the solid is triangles and quads, bucketed: then the distinct keys, in order, are
+  /// the solid's distinct edges as unique_edges gives them.
+  bool polygons() const { return polygons_; }
 
   /// Calls group(std::span<const FacetUse>) for every distinct key, in key order.
   template <class Group> void for_each(Group&& group) const {
-    if (!tets_) {
+    if (!tets_ && !polygons_) {
       for (std::size_t i = 0; i < uses_.size();) {
         std::size_t j = i + 1;
         while (j < uses_.size() && uses_[j].key == uses_[i].key) ++j;
@@ -315,9 +327,15 @@ class FacetGroups {
   static bool same_key(const Keyed& x, const Keyed& y) { return x.k1 == y.k1 && x.k2 == y.k2; }
 
   /// The sorted key (a <= b <= c) of use id: facet f of a tetrahedron (Gmsh's table) is the
-  /// triple without node 3 - f.
+  /// triple without node 3 - f; of a triangle or quad, its nodes f and f + 1 (a <= b, c = -1).
   std::array<std::int32_t, 3> key_of_use(std::uint32_t id) const {
     const VertexId* v = els_.nodes(ElemId{static_cast<std::int32_t>(id >> 2)});
+    if (polygons_) {
+      const auto e = static_cast<std::size_t>(id >> 2);
+      const auto f = static_cast<std::int32_t>(id & 3u);
+      const std::int32_t a = v[f].v, b = v[f + 1 == els_.offset[e + 1] - els_.offset[e] ? 0 : f + 1].v;
+      return {std::min(a, b), std::max(a, b), -1};
+    }
     const int skip = 3 - static_cast<int>(id & 3u);
     std::array<std::int32_t, 3> t{};
     int m = 0;
@@ -339,10 +357,10 @@ class FacetGroups {
   }
 
   const Elements& els_;
-  bool tets_ = false;
+  bool tets_ = false, polygons_ = false;
   std::size_t n_groups_ = 0;
   std::vector<FacetUse> uses_;         ///< other element types: facet_uses
-  std::vector<std::uint32_t> start_;   ///< tetrahedra: bucket b (smallest node b) is ids_[start_[b], start_[b + 1])
+  std::vector<std::uint32_t> start_;   ///< bucketed: bucket b (smallest node b) is ids_[start_[b], start_[b + 1])
   std::vector<std::uint32_t> ids_;     ///< element << 2 | local facet, by (key, element, local facet)
 };
 }  // namespace
@@ -536,11 +554,19 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
   std::vector<std::uint32_t> first_uses;
   [[maybe_unused]] const auto first_elem = [&](std::size_t i) { return ElemId{static_cast<std::int32_t>(first_uses[i] >> 3)}; };
   [[maybe_unused]] const auto first_local = [&](std::size_t i) { return static_cast<int>(first_uses[i] & 7u); };
+  // The solid's edges: the hanging-node check and the Euler characteristic (one list, not two:
+  // it was 3% of the 2D CLI's instructions). Of triangles and quads, the facet groups' keys (2D:
+  // unique_edges was 0.12 s of the validation's 0.44 at flange 968,326 triangles, one thread).
+  std::vector<std::array<VertexId, 2>> edges;
+  bool edges_listed = false;
   {
-    const FacetGroups groups(mesh.solid, options.n_threads);
+    const FacetGroups groups(mesh.solid, options.n_threads, options.bucketed_facets);
     if constexpr (Dim == 3) first_uses.reserve(groups.n_groups());
+    edges_listed = Dim == 2 && groups.polygons();
+    if (edges_listed) edges.reserve(groups.n_groups());
     groups.for_each([&](std::span<const FacetUse> g) {
       ++n_unique_facets;
+      if (edges_listed) edges.push_back({VertexId{g[0].key.v[0]}, VertexId{g[0].key.v[1]}});
       if constexpr (Dim == 3) first_uses.push_back(static_cast<std::uint32_t>(g[0].elem.v) << 3 | static_cast<std::uint32_t>(g[0].local));
       if (g.size() == 1) {
         boundary.push_back(g[0]);
@@ -666,9 +692,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     }
   }
 
-  // The solid's edges: the hanging-node check and the Euler characteristic (one list, not two:
-  // it was 3% of the 2D CLI's instructions).
-  const std::vector<std::array<VertexId, 2>> edges = unique_edges(mesh.solid);
+  if (!edges_listed) edges = unique_edges(mesh.solid);
 
   // Hanging nodes: on the interior of an edge (both dimensions) or of a facet (3D).
   {

@@ -422,6 +422,80 @@ TEST_CASE("the facet groups of many tetrahedra give the same report on 1, 2 and 
   }
 }
 
+TEST_CASE("bucketed facet groups give the slow twin's report: triangles and quads, tetrahedra", "[validate]") {
+  // Every kind of facet defect, in meshes of triangles, of quads, of both, and of tetrahedra:
+  // facets used three times (an element listed again), in the same orientation (an element
+  // turned over), a degenerate element (a node twice), interface elements missing, extra and
+  // reversed, and hanging nodes (the 2:1 meshes). The bucketed grouping (and in 2D the edges
+  // taken from it) against facet_uses and unique_edges: the same report, counts and Euler number.
+  const auto check = []<int Dim>(Mesh<Dim> mesh) {
+    auto& s = mesh.solid;
+    const std::size_t n = s.size();
+    const auto copy_of = [&](std::size_t e) {
+      const ElemId id{static_cast<std::int32_t>(e)};
+      return std::vector<VertexId>(s.nodes(id), s.nodes(id) + s.n_nodes_of(id));
+    };
+    std::vector<VertexId> again = copy_of(n / 2), over = copy_of(n / 3), flat = copy_of(n - 1);
+    std::swap(over[1], over[2]);
+    flat[1] = flat[0];
+    s.add(s.type[n / 2], again.data(), static_cast<int>(again.size()));
+    s.add(s.type[n / 3], over.data(), static_cast<int>(over.size()));
+    s.add(s.type[n - 1], flat.data(), static_cast<int>(flat.size()));
+    mesh.level.clear();
+    mesh.from_boundary_cell.clear();
+    auto& in = mesh.interface;
+    if (in.size() >= 3) {
+      std::vector<VertexId> turned(in.nodes(ElemId{1}), in.nodes(ElemId{1}) + in.n_nodes_of(ElemId{1}));
+      std::reverse(turned.begin(), turned.end());
+      Elements kept;
+      for (std::size_t f = 2; f < in.size(); ++f) kept.add(in.type[f], in.nodes(ElemId{static_cast<std::int32_t>(f)}), in.n_nodes_of(ElemId{static_cast<std::int32_t>(f)}));
+      kept.add(in.type[1], turned.data(), static_cast<int>(turned.size()));  // reversed; element 0's facet missing
+      kept.add(in.type[2], in.nodes(ElemId{2}), in.n_nodes_of(ElemId{2}));    // listed twice
+      in = kept;
+    }
+    ValidateOptions<Dim> vo;
+    vo.expected_euler = 1;
+    vo.max_problems = 1000;
+    for (const int threads : {1, 2}) {
+      vo.n_threads = threads;
+      vo.bucketed_facets = false;
+      const ValidationReport twin = validate<Dim>(mesh, vo);
+      vo.bucketed_facets = true;
+      const ValidationReport r = validate<Dim>(mesh, vo);
+      CAPTURE(Dim, n, threads);
+      CHECK(twin.nonconforming_facets > 0);
+      CHECK(twin.interface_missing > 0);
+      CHECK(twin.interface_extra > 0);
+      CHECK(twin.interface_reversed > 0);
+      CHECK(r.summary() == twin.summary());  // the counts and every problem, in the same order
+      CHECK(r.euler == twin.euler);
+      CHECK(r.n_problems == twin.n_problems);
+    }
+  };
+  check(test::grid_mesh<2>(7, true));
+  check(test::grid_mesh<2>(7, false));
+  check(test::hanging_mesh<2>(true));
+  check(test::hanging_mesh<2>(false));
+  check(test::grid_mesh<3>(4, true));
+  check(test::hanging_mesh<3>(true));
+  // Triangles and quads in one mesh: the grid's quads, every other one split in two triangles.
+  Mesh<2> mixed = test::grid_mesh<2>(6, false);
+  Elements both;
+  for (std::size_t e = 0; e < mixed.solid.size(); ++e) {
+    const VertexId* v = mixed.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    if (e % 2 == 0) {
+      both.add(ElemType::Quad4, v, 4);
+      continue;
+    }
+    const std::array<VertexId, 3> a = {v[0], v[1], v[2]}, b = {v[0], v[2], v[3]};
+    both.add(ElemType::Tri3, a.data(), 3);
+    both.add(ElemType::Tri3, b.data(), 3);
+  }
+  mixed.solid = both;
+  test::set_interface_to_boundary(mixed);
+  check(mixed);
+}
+
 TEMPLATE_TEST_CASE_SIG("content_hash changes with anything validate reads", "[validate]", ((int Dim), Dim), 2, 3) {
   // A report handed on with a mesh's hash applies only to that mesh: every array validate reads
   // changes the hash when one value in it changes (one ulp of a coordinate, one node id, one
