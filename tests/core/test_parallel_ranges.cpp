@@ -4,6 +4,9 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <set>
+#include <thread>
 #include <vector>
 
 #include "core/parallel_ranges.hpp"
@@ -23,6 +26,27 @@ TEST_CASE("range_max is the serial maximum on any thread count", "[parallel_rang
     CHECK(range_max(3, threads, [&](std::size_t i) { return v[i]; }) == std::max({v[0], v[1], v[2]}));
   }
   CHECK(range_max(0, 2, [](std::size_t) { return 1.0; }) == -std::numeric_limits<double>::infinity());
+}
+
+TEST_CASE("range_max and range_min run on as many threads as they are given", "[parallel_ranges][threads]") {
+  // With one part a thread, for_each_range's rule (fewer than two items a worker: one thread)
+  // ran every call on the caller alone.
+  for (const int threads : {2, 3}) {
+    std::mutex m;
+    std::set<std::thread::id> seen;
+    const auto f = [&](std::size_t i) {
+      if (i % 1000 == 0) {
+        const std::lock_guard<std::mutex> hold(m);
+        seen.insert(std::this_thread::get_id());
+      }
+      return static_cast<double>(i);
+    };
+    CHECK(range_max(100000, threads, f) == 99999.0);
+    CHECK(seen.size() == static_cast<std::size_t>(threads));
+    seen.clear();
+    CHECK(range_min(100000, threads, f) == 0.0);
+    CHECK(seen.size() == static_cast<std::size_t>(threads));
+  }
 }
 
 TEST_CASE("range_min is the serial minimum; chunk_starts is the serial layout", "[parallel_ranges][threads]") {
