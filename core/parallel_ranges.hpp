@@ -46,11 +46,21 @@ template <class F> void for_each_range(std::size_t n, int n_threads, const F& f)
 }
 
 /// The chunks [c * chunk, min(n, (c + 1) * chunk)) of [0, n): f(c, begin, end) for every chunk c,
-/// spread over n_threads by for_each_range. The chunks do not depend on n_threads.
+/// spread over n_threads in contiguous runs of chunks, one run a thread (at most one thread a
+/// chunk). The chunks do not depend on n_threads. (A chunk is its caller's unit of work: through
+/// for_each_range's rule, fewer than two items a worker on one thread, a call with a chunk a
+/// thread ran serially: the smoothing's slab histogram, range_max.)
 template <class F> void for_each_chunk(std::size_t n, std::size_t chunk, int n_threads, const F& f) {
   const std::size_t n_chunks = (n + chunk - 1) / chunk;
-  for_each_range(n_chunks, n_threads, [&](std::size_t first, std::size_t last) {
+  const std::size_t n_workers = std::min<std::size_t>(std::size_t(std::clamp(n_threads, 1, 256)), std::max<std::size_t>(n_chunks, 1));
+  const auto run = [&](std::size_t first, std::size_t last) {
     for (std::size_t c = first; c < last; ++c) f(c, c * chunk, std::min(n, (c + 1) * chunk));
+  };
+  if (n_workers == 1) return run(0, n_chunks);
+  // Worker w gets items [2w, 2w + 2) of for_each_range's 2 n_workers: its run of chunks.
+  for_each_range(2 * n_workers, static_cast<int>(n_workers), [&](std::size_t item, std::size_t) {
+    const std::size_t w = item / 2;
+    run(n_chunks * w / n_workers, n_chunks * (w + 1) / n_workers);
   });
 }
 

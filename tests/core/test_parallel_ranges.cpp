@@ -75,6 +75,27 @@ TEST_CASE("range_min is the serial minimum; chunk_starts is the serial layout", 
   CHECK(chunk_starts(0, 16, 2, std::size_t{3}, [](std::size_t, std::size_t) { return std::size_t{1}; }) == std::vector<std::size_t>{3});
 }
 
+TEST_CASE("for_each_chunk runs every chunk once, a chunk a thread when there are as many", "[parallel_ranges][threads]") {
+  for (const int threads : {1, 2, 3, 8})
+    for (const std::size_t n_chunks : {std::size_t(1), std::size_t(2), std::size_t(3), std::size_t(7), std::size_t(40)}) {
+      const std::size_t chunk = 5, n = chunk * n_chunks - 2;  // the last chunk is short
+      std::vector<std::atomic<int>> runs(n_chunks);
+      std::mutex m;
+      std::set<std::thread::id> seen;
+      for_each_chunk(n, chunk, threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+        CHECK(begin == c * chunk);
+        CHECK(end == std::min(n, (c + 1) * chunk));
+        ++runs[c];
+        const std::lock_guard<std::mutex> hold(m);
+        seen.insert(std::this_thread::get_id());
+      });
+      CAPTURE(threads, n_chunks);
+      for (const auto& r : runs) CHECK(r.load() == 1);
+      // (For_each_range alone ran 2 and 3 chunks on one thread.)
+      CHECK(seen.size() == std::min<std::size_t>(static_cast<std::size_t>(threads), n_chunks));
+    }
+}
+
 TEST_CASE("for_each_chunk_balanced hands out every chunk once, on every thread count", "[parallel_ranges][threads]") {
   // Uneven work (the later chunks cost more), per-worker state, and counts with and without a
   // short last chunk: every index is visited exactly once, and each worker's own state stays its.
