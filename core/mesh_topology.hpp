@@ -69,8 +69,9 @@ std::vector<BoundaryFacet> boundary_facets(const Elements& solid);
 
 /// Distinct edges of `els` as sorted node pairs, sorted. The edge uses are bucketed in runs of
 /// nodes of at most `run_uses` uses (0: a quarter of them, at least 2^20), one pass over the
-/// elements a run; the same result for every run length.
-std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els, std::size_t run_uses = 0);
+/// elements a run, on n_threads threads (each its own range of elements); the same result for
+/// every run length and thread count.
+std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els, std::size_t run_uses = 0, int n_threads = 1);
 
 /// Appends to `out` the distinct edge neighbours of node v in the polygons `elems` (the nodes
 /// before and after v in each), ascending. `listed` has a byte per node, all 0; it marks the

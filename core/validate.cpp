@@ -692,7 +692,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
     }
   }
 
-  if (!edges_listed) edges = unique_edges(mesh.solid);
+  if (!edges_listed) edges = unique_edges(mesh.solid, 0, options.n_threads);
 
   // Hanging nodes: on the interior of an edge (both dimensions) or of a facet (3D).
   {

@@ -44,6 +44,11 @@ void check_same_as_ref(const Elements& els) {
   CHECK(unique_edges(els) == edges);
   for (const std::size_t run : {1, 2, 5, 17})  // runs of nodes: several passes, long buckets alone
     CHECK(unique_edges(els, run) == edges);
+  for (const int threads : {2, 3, 8})  // element ranges on the threads, in one run or several
+    for (const std::size_t run : {0, 1, 5}) {
+      CAPTURE(threads, run);
+      CHECK(unique_edges(els, run, threads) == edges);
+    }
   std::vector<std::pair<int, int>> fast;
   for (const BoundaryFacet& b : boundary_facets(els)) {
     fast.emplace_back(b.elem.v, b.local);
