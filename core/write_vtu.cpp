@@ -1,4 +1,5 @@
-// VTU text built with std::to_chars in one buffer.
+// VTU text built with std::to_chars in one buffer; with VtuEncoding::Binary the arrays as raw
+// appended data.
 
 #include "core/write_vtu.hpp"
 
@@ -6,9 +7,13 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <cstdio>
+#include <limits>
 #include <memory>
+#include <type_traits>
+#include <vector>
 
 #include "core/error.hpp"
 #include "core/spill_buffer.hpp"
@@ -28,6 +33,8 @@ class Text : public SpillBuffer {
     put(s);
     return *this;
   }
+  /// Raw bytes (the appended block of a binary file).
+  void bytes(const void* p, std::size_t n) { put(std::string_view(static_cast<const char*>(p), n)); }
   template <class Num> Text& num(Num v) {
     append_number(v);
     put(' ');
@@ -69,21 +76,64 @@ int vtk_local(ElemType t, int i) {
   return t == ElemType::Prism6 ? prism[i] : i;
 }
 
-/// A DataArray of `count` values, value(i) for i = 0, 1, ... in order, twelve to a line.
-template <class Value>
-void array(Text& out, const char* type, const char* name, int components, std::size_t count, Value&& value) {
-  out << "        <DataArray type=\"" << type << "\" Name=\"" << name << "\"";
-  if (components > 1) out << " NumberOfComponents=\"" << std::to_string(components) << "\"";
-  out << " format=\"ascii\">\n";
-  for (std::size_t i = 0, on_line = 0; i < count; ++i) {
-    out.num(value(i));
-    if (++on_line == 12 || i + 1 == count) {
-      out << "\n";
+/// VTK's name of the value type T.
+template <class T> constexpr const char* vtk_value_type() {
+  if constexpr (std::is_same_v<T, double>) return "Float64";
+  else if constexpr (std::is_same_v<T, float>) return "Float32";
+  else if constexpr (std::is_same_v<T, std::int64_t>) return "Int64";
+  else if constexpr (std::is_same_v<T, std::int32_t>) return "Int32";
+  else if constexpr (std::is_same_v<T, std::uint8_t>) return "UInt8";
+  else static_assert(sizeof(T) == 0, "no VTK type");
+}
+
+/// How write_vtu_text writes its arrays. ASCII: in place, as text. Binary (VtuEncoding::Binary,
+/// VTK's raw appended data): a first pass writes the XML with each array's offset into the
+/// appended block (and no values), a second pass the block alone: for each array its size in
+/// bytes (UInt64) and its values, little-endian as the machine's.
+struct Pass {
+  bool binary = false;
+  bool block = false;        ///< the second pass: values only
+  std::uint64_t offset = 0;  ///< the appended block's size so far (first pass)
+};
+
+/// A DataArray of `count` values of type T, value(i) for i = 0, 1, ... in order (twelve to a
+/// line in ASCII; Float32 rounded to six decimals there, Fixed6). XML goes to `xml`, the
+/// binary block to `out`.
+template <class T, class Value>
+void array(Text& xml, Text& out, Pass& pass, const char* name, int components, std::size_t count, Value&& value) {
+  if (!pass.block) {
+    xml << "        <DataArray type=\"" << vtk_value_type<T>() << "\" Name=\"" << name << "\"";
+    if (components > 1) xml << " NumberOfComponents=\"" << std::to_string(components) << "\"";
+  }
+  if (pass.binary && !pass.block) {
+    xml << " format=\"appended\" offset=\"" << std::to_string(pass.offset) << "\"/>\n";
+    pass.offset += sizeof(std::uint64_t) + count * sizeof(T);
+    return;
+  }
+  if (pass.binary) {
+    const std::uint64_t n_bytes = count * sizeof(T);
+    out.bytes(&n_bytes, sizeof n_bytes);
+    constexpr std::size_t batch = 4096;
+    T values[batch];
+    for (std::size_t i = 0; i < count;) {
+      const std::size_t n = std::min(batch, count - i);
+      for (std::size_t k = 0; k < n; ++k, ++i) values[k] = static_cast<T>(value(i));
+      out.bytes(values, n * sizeof(T));
       out.maybe_flush();
+    }
+    return;
+  }
+  xml << " format=\"ascii\">\n";
+  for (std::size_t i = 0, on_line = 0; i < count; ++i) {
+    if constexpr (std::is_same_v<T, float>) xml.num(Fixed6{static_cast<double>(value(i))});
+    else xml.num(value(i));
+    if (++on_line == 12 || i + 1 == count) {
+      xml << "\n";
+      xml.maybe_flush();
       on_line = 0;
     }
   }
-  out << "        </DataArray>\n";
+  xml << "        </DataArray>\n";
 }
 
 /// The solid elements at each node with a slot (slot[v] >= 0; nodes with negative ids have
@@ -199,29 +249,37 @@ template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& m
 // Every array is generated from the mesh as it is written: the value arrays and the text were
 // ~2x the mesh at the CLI's memory peak. Connectivity and offsets walk the elements in order
 // (solid, then interface) with a cursor that the array's index follows.
-template <int Dim> void write_vtu_text(Text& out, const Mesh<Dim>& mesh) {
+/// array<Wide>, but in binary array<Narrow> when `narrow` (every value fits it): node ids and
+/// offsets as Int32, the small cell data as UInt8 (the text keeps its types, and its bytes).
+template <class Wide, class Narrow, class Value>
+void array_narrowed(Text& xml, Text& out, Pass& pass, bool narrow, const char* name, std::size_t count, Value&& value) {
+  if (pass.binary && narrow) array<Narrow>(xml, out, pass, name, 1, count, value);
+  else array<Wide>(xml, out, pass, name, 1, count, value);
+}
+
+// The XML goes to `xml` and the binary block to `out` (Pass); `owner`: interface_owners.
+template <int Dim>
+void write_vtu_text(Text& xml, Text& out, Pass& pass, const Mesh<Dim>& mesh, const std::vector<std::int32_t>& owner) {
   const std::size_t ns = mesh.solid.size(), ni = mesh.interface.size(), n = ns + ni;
   const Elements* const parts[2] = {&mesh.solid, &mesh.interface};
   auto element = [&](std::size_t c) { return c < ns ? std::pair{parts[0], c} : std::pair{parts[1], c - ns}; };
   // The owners' level and from_boundary_cell for the interface cells.
-  std::vector<std::int32_t> owner;
-  if (ni != 0) owner = interface_owners<Dim>(mesh);
   auto level_of = [&](std::size_t e) { return e < mesh.level.size() ? int(mesh.level[e]) : 0; };
   auto from_boundary_of = [&](std::size_t e) {
     return e < mesh.from_boundary_cell.size() ? int(mesh.from_boundary_cell[e]) : 0;
   };
 
-  out << "<?xml version=\"1.0\"?>\n"
+  xml << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
       << "  <UnstructuredGrid>\n"
       << "    <Piece NumberOfPoints=\"" << std::to_string(mesh.points.size()) << "\" NumberOfCells=\""
       << std::to_string(n) << "\">\n"
       << "      <Points>\n";
-  array(out, "Float64", "Points", 3, 3 * mesh.points.size(), [&](std::size_t i) {
+  array<double>(xml, out, pass, "Points", 3, 3 * mesh.points.size(), [&](std::size_t i) {
     const int d = static_cast<int>(i % 3);
     return d < Dim ? mesh.points[i / 3][d] : 0.0;
   });
-  out << "      </Points>\n      <Cells>\n";
+  xml << "      </Points>\n      <Cells>\n";
   {
     std::size_t cell = 0;
     int local = 0;
@@ -230,7 +288,8 @@ template <int Dim> void write_vtu_text(Text& out, const Mesh<Dim>& mesh) {
       const auto [els, e] = element(c);
       n_conn += static_cast<std::size_t>(els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)}));
     }
-    array(out, "Int64", "connectivity", 1, n_conn, [&](std::size_t) {
+    const bool narrow = mesh.points.size() <= std::size_t(std::numeric_limits<std::int32_t>::max());
+    array_narrowed<std::int64_t, std::int32_t>(xml, out, pass, narrow, "connectivity", n_conn, [&](std::size_t) {
       for (;; local = 0, ++cell) {
         const auto [els, e] = element(cell);
         const ElemId id{static_cast<std::int32_t>(e)};
@@ -243,57 +302,79 @@ template <int Dim> void write_vtu_text(Text& out, const Mesh<Dim>& mesh) {
     });
   }
   {
-    std::int64_t end = 0;
-    array(out, "Int64", "offsets", 1, n, [&](std::size_t c) {
+    std::int64_t end = 0, n_conn = 0;
+    for (std::size_t c = 0; c < n; ++c) {
+      const auto [els, e] = element(c);
+      n_conn += els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
+    }
+    const bool narrow = n_conn <= std::numeric_limits<std::int32_t>::max();
+    array_narrowed<std::int64_t, std::int32_t>(xml, out, pass, narrow, "offsets", n, [&](std::size_t c) {
       const auto [els, e] = element(c);
       end += els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
       return end;
     });
   }
-  array(out, "UInt8", "types", 1, n, [&](std::size_t c) {
+  array<std::uint8_t>(xml, out, pass, "types", 1, n, [&](std::size_t c) {
     const auto [els, e] = element(c);
     return vtk_type(els->type[e]);
   });
-  out << "      </Cells>\n      <CellData Scalars=\"quality\">\n";
-  array(out, "Float32", "quality", 1, n, [&](std::size_t c) {
+  xml << "      </Cells>\n      <CellData Scalars=\"quality\">\n";
+  array<float>(xml, out, pass, "quality", 1, n, [&](std::size_t c) {
     const auto [els, e] = element(c);
     const auto ep = element_points<Dim>(*els, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
-    return Fixed6{scaled_jacobian<Dim>(els->type[e], ep.span())};
+    return scaled_jacobian<Dim>(els->type[e], ep.span());
   });
-  array(out, "Int32", "level", 1, n, [&](std::size_t c) {
+  array_narrowed<std::int32_t, std::uint8_t>(xml, out, pass, true, "level", n, [&](std::size_t c) {
     if (c < ns) return level_of(c);
     const std::int32_t o = owner[c - ns];
     return o >= 0 ? level_of(static_cast<std::size_t>(o)) : 0;
   });
-  array(out, "Int32", "from_boundary_cell", 1, n, [&](std::size_t c) {
+  array_narrowed<std::int32_t, std::uint8_t>(xml, out, pass, true, "from_boundary_cell", n, [&](std::size_t c) {
     if (c < ns) return from_boundary_of(c);
     const std::int32_t o = owner[c - ns];
     return o >= 0 ? from_boundary_of(static_cast<std::size_t>(o)) : 0;
   });
-  array(out, "Int32", "group", 1, n, [&](std::size_t c) { return c < ns ? 1 : 2; });
-  out << "      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n";
+  array_narrowed<std::int32_t, std::uint8_t>(xml, out, pass, true, "group", n, [&](std::size_t c) { return c < ns ? 1 : 2; });
+  xml << "      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n";
+}
+
+/// The whole file into `out`: the XML, and with a binary encoding the appended block.
+template <int Dim> void write_vtu_to(Text& out, const Mesh<Dim>& mesh, VtuEncoding encoding) {
+  std::vector<std::int32_t> owner;
+  if (mesh.interface.size() != 0) owner = interface_owners<Dim>(mesh);
+  Pass pass;
+  pass.binary = encoding == VtuEncoding::Binary;
+  write_vtu_text<Dim>(out, out, pass, mesh, owner);
+  if (pass.binary) {
+    out << "  <AppendedData encoding=\"raw\">\n   _";
+    Text no_xml;  // the second pass writes values only
+    pass.block = true;
+    write_vtu_text<Dim>(no_xml, out, pass, mesh, owner);
+    out << "\n  </AppendedData>\n";
+  }
+  out << "</VTKFile>\n";
 }
 
 }  // namespace
 
-template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh) {
+template <int Dim> std::string vtu_string(const Mesh<Dim>& mesh, VtuEncoding encoding) {
   Text out;
-  write_vtu_text<Dim>(out, mesh);
+  write_vtu_to<Dim>(out, mesh, encoding);
   return out.take();
 }
 
-template <int Dim> void write_vtu(const Mesh<Dim>& mesh, const std::filesystem::path& path) {
+template <int Dim> void write_vtu(const Mesh<Dim>& mesh, const std::filesystem::path& path, VtuEncoding encoding) {
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "wb"), &std::fclose);
   if (!file) throw InputError("cannot open " + path.string() + " for writing: " + std::strerror(errno));
   Text out(file.get(), path.string());
-  write_vtu_text<Dim>(out, mesh);
+  write_vtu_to<Dim>(out, mesh, encoding);
   out.flush();
   if (std::fflush(file.get()) != 0) throw InputError("cannot write " + path.string() + ": " + std::strerror(errno));
 }
 
-template std::string vtu_string<2>(const Mesh<2>&);
-template std::string vtu_string<3>(const Mesh<3>&);
-template void write_vtu<2>(const Mesh<2>&, const std::filesystem::path&);
-template void write_vtu<3>(const Mesh<3>&, const std::filesystem::path&);
+template std::string vtu_string<2>(const Mesh<2>&, VtuEncoding);
+template std::string vtu_string<3>(const Mesh<3>&, VtuEncoding);
+template void write_vtu<2>(const Mesh<2>&, const std::filesystem::path&, VtuEncoding);
+template void write_vtu<3>(const Mesh<3>&, const std::filesystem::path&, VtuEncoding);
 
 }  // namespace febemesh

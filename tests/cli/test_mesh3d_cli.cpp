@@ -97,7 +97,7 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads with features and slidi
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary", "[cli][mesh3d]") {
+TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary, and mesh.vtu as raw appended binary", "[cli][mesh3d]") {
   const SpherePair runs("binary", 3, "--binary");  // a: ASCII, b: binary
   const std::string ascii = read_text(runs.msh("a")), binary = read_text(runs.msh("b"));
   CHECK(binary.find("$MeshFormat\n4.1 1 8\n") == 0);
@@ -109,6 +109,14 @@ TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary", "[cli][mesh3
   CHECK(febemesh::msh_string(a) == febemesh::msh_string(b));
   CHECK(runs.report("b")["options"]["msh_encoding"] == "binary");
   CHECK(runs.report("a")["options"]["msh_encoding"] == "ascii");
+  // mesh.vtu too: raw appended arrays, fewer bytes than the text (core/test_vtu.cpp decodes them).
+  const std::string vtu_a = read_text(runs.dir / "a" / "mesh.vtu"), vtu_b = read_text(runs.dir / "b" / "mesh.vtu");
+  CHECK(vtu_a.find("format=\"ascii\"") != std::string::npos);
+  CHECK(vtu_b.find("format=\"appended\"") != std::string::npos);
+  CHECK(vtu_b.find("<AppendedData encoding=\"raw\">") != std::string::npos);
+  CHECK(vtu_b.size() < vtu_a.size());
+  CHECK(runs.report("b")["options"]["vtu_encoding"] == "binary");
+  CHECK(runs.report("a")["options"]["vtu_encoding"] == "ascii");
 }
 
 TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores the buffer rule's try first", "[cli][mesh3d]") {
