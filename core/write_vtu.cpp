@@ -4,6 +4,7 @@
 #include "core/write_vtu.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -111,6 +112,7 @@ void array(Text& xml, Text& out, Pass& pass, const char* name, int components, s
     return;
   }
   if (pass.binary) {
+    static_assert(std::endian::native == std::endian::little, "the file says LittleEndian");
     const std::uint64_t n_bytes = count * sizeof(T);
     out.bytes(&n_bytes, sizeof n_bytes);
     constexpr std::size_t batch = 4096;
@@ -246,9 +248,6 @@ template <int Dim> std::vector<std::int32_t> interface_owners(const Mesh<Dim>& m
   return out;
 }
 
-// Every array is generated from the mesh as it is written: the value arrays and the text were
-// ~2x the mesh at the CLI's memory peak. Connectivity and offsets walk the elements in order
-// (solid, then interface) with a cursor that the array's index follows.
 /// array<Wide>, but in binary array<Narrow> when `narrow` (every value fits it): node ids and
 /// offsets as Int32, the small cell data as UInt8 (the text keeps its types, and its bytes).
 template <class Wide, class Narrow, class Value>
@@ -257,7 +256,10 @@ void array_narrowed(Text& xml, Text& out, Pass& pass, bool narrow, const char* n
   else array<Wide>(xml, out, pass, name, 1, count, value);
 }
 
-// The XML goes to `xml` and the binary block to `out` (Pass); `owner`: interface_owners.
+// Every array is generated from the mesh as it is written: the value arrays and the text were
+// ~2x the mesh at the CLI's memory peak. Connectivity and offsets walk the elements in order
+// (solid, then interface) with a cursor that the array's index follows. The XML goes to `xml`
+// and the binary block to `out` (Pass); `owner`: interface_owners.
 template <int Dim>
 void write_vtu_text(Text& xml, Text& out, Pass& pass, const Mesh<Dim>& mesh, const std::vector<std::int32_t>& owner) {
   const std::size_t ns = mesh.solid.size(), ni = mesh.interface.size(), n = ns + ni;
