@@ -445,7 +445,8 @@ std::vector<std::array<VertexId, 2>> edge_list(const Elements& els) {
 // each thread passes over its own range of elements (its uses counted per node, 8 B a node a
 // thread, and written after the earlier ranges' uses of the node), and the buckets are sorted
 // in chunks: the same buckets, so the same edges. (All serial, it was 85 ms of the 3D
-// validation's 490 on two threads, sphere966 at 995,232 tetrahedra.)
+// validation's 490 on two threads, sphere966 at 995,232 tetrahedra; validate alone then took
+// 426-440 ms against 434-465, and bench_mesh3d's validation showed no change beyond its noise.)
 std::vector<std::array<VertexId, 2>> unique_edges(const Elements& els, std::size_t run_uses, int n_threads) {
   // Calls visit(smaller, larger) for every edge use of elements [e0, e1) (tetrahedra: every
   // pair, in any order; the result is sorted).
