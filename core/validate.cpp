@@ -760,11 +760,60 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
           if (on_quad_interior(pts[c], f, h, pts, rel)) at(c);
         });
       };
-      const std::vector<std::uint8_t> facet_hit = marked(first_uses.size(), [&](std::size_t i) {
-        bool hit = false;
-        on_interior(i, [&](std::int32_t) { hit = true; });
-        return hit;
-      });
+      // Whether some node lies on each facet's interior. Of tetrahedra, one grid query a
+      // tetrahedron for the facets whose first use it is (about two: the query per facet was most
+      // of this check), each candidate then tested against each facet's own box and plane: the
+      // nodes each facet's query gives, so the same marks.
+      const bool all_tets = options.bucketed_facets && std::all_of(mesh.solid.type.begin(), mesh.solid.type.end(),
+                                                                   [](ElemType t) { return t == ElemType::Tet4; });
+      std::vector<std::uint8_t> facet_hit;
+      if (all_tets) {
+        std::vector<std::uint8_t> firsts(mesh.solid.size(), 0), hits(mesh.solid.size(), 0);
+        for (const std::uint32_t u : first_uses) firsts[u >> 3] |= static_cast<std::uint8_t>(1u << (u & 7u));
+        for_each_range(mesh.solid.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
+          for (std::size_t e = begin; e < end; ++e) {
+            if (firsts[e] == 0) continue;
+            struct Side {
+              Facet f;
+              Box<3> box;
+              TriangleInterior tri;
+              std::uint8_t bit;
+            };
+            std::array<std::optional<Side>, 4> sides;
+            Box<3> all = Box<3>::empty();
+            for (int k = 0; k < 4; ++k) {
+              if (!(firsts[e] >> k & 1u)) continue;
+              const Facet f = facet_of(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, k);
+              Box<3> box = Box<3>::empty();
+              for (int j = 0; j < 3; ++j) box.expand(pts[f.node[j].v]);
+              const double h = facet_size(f, pts);
+              box.lo.array() -= rel * h;
+              box.hi.array() += rel * h;
+              all.expand(box.lo);
+              all.expand(box.hi);
+              sides[k].emplace(Side{f, box, TriangleInterior(pts[f.node[0].v], pts[f.node[1].v], pts[f.node[2].v], h, rel),
+                                    static_cast<std::uint8_t>(1u << k)});
+            }
+            std::uint8_t hit = 0;
+            grid.query(all, [&](std::int32_t c) {
+              for (const std::optional<Side>& side : sides) {
+                if (!side || (hit & side->bit) || !side->box.contains(pts[c])) continue;
+                const Facet& f = side->f;
+                if (c != f.node[0].v && c != f.node[1].v && c != f.node[2].v && side->tri.contains(pts[c])) hit |= side->bit;
+              }
+            });
+            hits[e] = hit;
+          }
+        });
+        facet_hit.resize(first_uses.size());
+        for (std::size_t i = 0; i < first_uses.size(); ++i) facet_hit[i] = hits[first_uses[i] >> 3] >> (first_uses[i] & 7u) & 1u;
+      } else {
+        facet_hit = marked(first_uses.size(), [&](std::size_t i) {
+          bool hit = false;
+          on_interior(i, [&](std::int32_t) { hit = true; });
+          return hit;
+        });
+      }
       for (std::size_t i = 0; i < first_uses.size(); ++i)
         if (facet_hit[i]) {
           // In node order, whatever the grid's cells (PointGrid sizes them by the points).

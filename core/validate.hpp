@@ -35,8 +35,10 @@ template <int Dim> struct ValidateOptions {
   /// safe to call concurrently); the report is the same for every count.
   int n_threads = 1;
   /// Tests only: false groups the facets of a solid of tetrahedra, or of triangles and quads,
-  /// through facet_uses (24 bytes a use, one sort) and takes the 2D edges from unique_edges, the
-  /// way every other solid is checked, as the slow twin of the bucketed grouping. The same report.
+  /// through facet_uses (24 bytes a use, one sort), takes the 2D edges from unique_edges and
+  /// looks for nodes on the facets of tetrahedra one facet at a time, the way every other solid
+  /// is checked: the slow twin of the bucketed grouping and the per-tetrahedron facet queries.
+  /// The same report.
   bool bucketed_facets = true;
 };
 
