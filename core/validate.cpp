@@ -795,13 +795,19 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
                                     static_cast<std::uint8_t>(1u << k)});
             }
             std::uint8_t hit = 0;
-            grid.query(all, [&](std::int32_t c) {
+            const auto test = [&](std::int32_t c, std::uint8_t only) {
               for (const std::optional<Side>& side : sides) {
-                if (!side || (hit & side->bit) || !side->box.contains(pts[c])) continue;
+                if (!side || !(side->bit & only) || (hit & side->bit) || !side->box.contains(pts[c])) continue;
                 const Facet& f = side->f;
                 if (c != f.node[0].v && c != f.node[1].v && c != f.node[2].v && side->tri.contains(pts[c])) hit |= side->bit;
               }
-            });
+            };
+            if (all.lo.allFinite() && all.hi.allFinite()) {
+              grid.query(all, [&](std::int32_t c) { test(c, 0xf); });
+            } else {  // (a node not finite: each facet's own query, as the twin does)
+              for (const std::optional<Side>& side : sides)
+                if (side) grid.query(side->box, [&](std::int32_t c) { test(c, side->bit); });
+            }
             hits[e] = hit;
           }
         });

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 
 #include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
@@ -480,6 +481,9 @@ TEST_CASE("bucketed facet groups give the slow twin's report: triangles and quad
   check(test::hanging_mesh<2>(false));
   check(test::grid_mesh<3>(4, true));
   check(test::hanging_mesh<3>(true));
+  Mesh<3> not_finite = test::grid_mesh<3>(3, true);  // a node's box, and its tetrahedra's, not finite
+  not_finite.points[21][1] = std::numeric_limits<double>::quiet_NaN();
+  check(not_finite);
   // Triangles and quads in one mesh: the grid's quads, every other one split in two triangles.
   Mesh<2> mixed = test::grid_mesh<2>(6, false);
   Elements both;
