@@ -425,7 +425,7 @@ TEST_CASE("the facet groups of many tetrahedra give the same report on 1, 2 and 
 
 TEST_CASE("bucketed facet groups give the slow twin's report: triangles and quads, tetrahedra", "[validate]") {
   // (In 3D the twin also queries the nodes near each facet on its own, not a tetrahedron's
-  // facets at once: the hanging meshes put nodes on facet interiors.)
+  // facets at once; the overlapping-tetrahedron test above has a node on a facet's interior.)
   // Every kind of facet defect, in meshes of triangles, of quads, of both, and of tetrahedra:
   // facets used three times (an element listed again), in the same orientation (an element
   // turned over), a degenerate element (a node twice), interface elements missing, extra and
