@@ -175,12 +175,14 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
   // Distances to the curve by lattice key: a corner is shared by two free edges, and most free
   // edges of one pass are free edges of the next. A midpoint (a + b on the doubled lattice)
   // names its edge: edges of different lengths or axes never share one. The facets in one
-  // range a thread, each range with caches of its own (a facet's verdict depends on its
+  // range a thread's worth, each range with caches of its own (a facet's verdict depends on its
   // distances only: the same drops for every count; the first pass was 0.08 s of the 2D
-  // classify stage at flange 1e6, serial). But for_each_range runs fewer than two items a
-  // worker on one thread, so on two threads these two ranges run one after the other (4 ms at
-  // flange 1e6, session 39); four ranges a thread were slower (10 ms): the unordered_maps
-  // allocate each entry, from the one malloc arena, on both threads at once.
+  // classify stage at flange 1e6, serial). The ranges run one after the other, on this thread:
+  // on their threads at once they were slower, the unordered_maps allocating each entry from
+  // the one malloc arena on both threads (bench_mesh2d flange 1e6, two threads, classify stage
+  // 0.024-0.027 s one after the other, 0.034-0.042 at once, session 40; four ranges a thread,
+  // 4 -> 10 ms, session 39). A cache that does not allocate an entry at a time would let them run
+  // at once.
   const std::size_t n_ranges = static_cast<std::size_t>(std::clamp(n_threads, 1, 256));
   struct Caches {
     std::unordered_map<std::uint64_t, double> corner_distance, midpoint_distance;
@@ -198,7 +200,7 @@ std::size_t apply_buffer(const Orthtree<2>& t, Flags& in, const CurveBoundary& c
     if (pass > 0) update_free_facets(t, keys, in, drop, facets);
     near.assign(facets.size(), 0);
     const std::size_t chunk = std::max<std::size_t>(1, (facets.size() + n_ranges - 1) / n_ranges);
-    for_each_chunk(facets.size(), chunk, n_threads, [&](std::size_t r, std::size_t begin, std::size_t end) {
+    for_each_chunk(facets.size(), chunk, 1, [&](std::size_t r, std::size_t begin, std::size_t end) {
       Caches& cache = caches[r];
       for (std::size_t k = begin; k < end; ++k) {
         const FreeFacet<2>& f = facets[k];
