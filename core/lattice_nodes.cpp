@@ -73,6 +73,12 @@ void radix_sort(std::vector<std::uint64_t>& keys, int n_threads) {
   });
 }
 
+/// LimitError when n nodes would not have 32-bit ids.
+void check_node_ids(std::size_t n) {
+  if (n > std::size_t(std::numeric_limits<std::int32_t>::max()))
+    throw LimitError("lattice_nodes: " + std::to_string(n) + " nodes exceed 32-bit node ids");
+}
+
 /// The nodes and every kept leaf's corner nodes from one sort: each corner key packed with its
 /// place (leaf * n_corners + corner) below it, sorted, then read in order (a new key, a new
 /// node). The same nodes and corners as sorting the keys alone and searching each corner
@@ -122,8 +128,7 @@ bool sort_with_corners(const Orthtree<Dim>& t, const Kept& kept, std::size_t run
         return k;
       });
   const std::size_t n_nodes = first_id.back();
-  if (n_nodes > std::size_t(std::numeric_limits<std::int32_t>::max()))
-    throw LimitError("lattice_nodes: " + std::to_string(n_nodes) + " nodes exceed 32-bit node ids");
+  check_node_ids(n_nodes);
   reserve_huge(nodes.points, n_nodes, n_threads);
   nodes.points.resize(n_nodes);
   const std::uint64_t fixed = all & ~(part_mask << low);
@@ -147,9 +152,7 @@ void sort_then_search(const Orthtree<Dim>& t, const Kept& kept, std::vector<std:
   const std::size_t n_leaves = t.n_leaves();
   radix_sort(keys, n_threads);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  if (keys.size() > std::size_t(std::numeric_limits<std::int32_t>::max())) {
-    throw LimitError("lattice_nodes: " + std::to_string(keys.size()) + " nodes exceed 32-bit node ids");
-  }
+  check_node_ids(keys.size());
 
   reserve_huge(nodes.points, keys.size(), n_threads);
   nodes.points.resize(keys.size());

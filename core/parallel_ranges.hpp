@@ -108,10 +108,7 @@ std::vector<T> chunk_starts(std::size_t n, std::size_t chunk, int n_threads, con
 /// The largest f(i) over [0, n) (-infinity when n is 0; a NaN never wins), on n_threads
 /// threads: a maximum is exact in any order, so the same value for every count.
 template <class F> double range_max(std::size_t n, int n_threads, const F& f) {
-  // Two parts a thread: for_each_range runs fewer than two items a worker on one thread, and
-  // with one part a thread every call ran serially (the 2D angle optimiser's and quality pass's
-  // minima over all elements, the smoothing's slab bounds).
-  const std::size_t n_parts = 2 * std::size_t(std::clamp(n_threads, 1, 256));
+  const std::size_t n_parts = std::size_t(std::clamp(n_threads, 1, 256));
   std::vector<double> best(n_parts, -std::numeric_limits<double>::infinity());
   for_each_chunk(n, std::max<std::size_t>(1, (n + n_parts - 1) / n_parts), n_threads,
                  [&](std::size_t c, std::size_t begin, std::size_t end) {

@@ -282,14 +282,14 @@ void write_vtu_text(Text& xml, Text& out, Pass& pass, const Mesh<Dim>& mesh, con
     return d < Dim ? mesh.points[i / 3][d] : 0.0;
   });
   xml << "      </Points>\n      <Cells>\n";
+  std::size_t n_conn = 0;
+  for (std::size_t c = 0; c < n; ++c) {
+    const auto [els, e] = element(c);
+    n_conn += static_cast<std::size_t>(els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)}));
+  }
   {
     std::size_t cell = 0;
     int local = 0;
-    std::size_t n_conn = 0;
-    for (std::size_t c = 0; c < n; ++c) {
-      const auto [els, e] = element(c);
-      n_conn += static_cast<std::size_t>(els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)}));
-    }
     const bool narrow = mesh.points.size() <= std::size_t(std::numeric_limits<std::int32_t>::max());
     array_narrowed<std::int64_t, std::int32_t>(xml, out, pass, narrow, "connectivity", n_conn, [&](std::size_t) {
       for (;; local = 0, ++cell) {
@@ -304,12 +304,8 @@ void write_vtu_text(Text& xml, Text& out, Pass& pass, const Mesh<Dim>& mesh, con
     });
   }
   {
-    std::int64_t end = 0, n_conn = 0;
-    for (std::size_t c = 0; c < n; ++c) {
-      const auto [els, e] = element(c);
-      n_conn += els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
-    }
-    const bool narrow = n_conn <= std::numeric_limits<std::int32_t>::max();
+    std::int64_t end = 0;
+    const bool narrow = n_conn <= std::size_t(std::numeric_limits<std::int32_t>::max());
     array_narrowed<std::int64_t, std::int32_t>(xml, out, pass, narrow, "offsets", n, [&](std::size_t c) {
       const auto [els, e] = element(c);
       end += els->n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
