@@ -27,6 +27,7 @@
 #include "core/write_msh.hpp"
 #include "core/write_vtu.hpp"
 #include "dim3/fidelity3d.hpp"
+#include "dim3/figures3d.hpp"
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_boundary.hpp"
 
@@ -35,6 +36,11 @@ namespace {
 
 /// The finest global level --level and --size may ask for (octants of the root's side / 2^9).
 constexpr int finest_level = 9;
+
+/// --figures auto: a figure of more polygons than this is not drawn (an SVG of 6 * 10^4 shapes,
+/// about 5 MB, still opens in a browser in a few seconds; sphere966 level 5 at 199,647 tets cuts
+/// 6,000-7,000 polygons a plane).
+constexpr std::size_t auto_figures_max_shapes = 60000;
 
 /// x as printf's %g (6 significant digits).
 std::string fmt_g(double x) {
@@ -82,7 +88,8 @@ const char* help_text =
     "smoothing; with --elements hex the tetrahedra of each octant are merged into a hexahedron\n"
     "or pyramids where that conforms.\n\n"
     "options:\n"
-    "  -o DIR              output folder (mesh.msh, mesh.vtu, report.json), written atomically\n"
+    "  -o DIR              output folder (mesh.msh, mesh.vtu, report.json, figures/),\n"
+    "                      written atomically\n"
     "  --level N           global octree level at the surface (1..9, default 4)\n"
     "  --size H            instead of --level: the octants' side at the surface, in the\n"
     "                      surface's units (the level whose octants are no larger, in a\n"
@@ -134,6 +141,13 @@ const char* help_text =
     "  --binary            write mesh.msh as MSH 4.1 binary (faster to write and read, not\n"
     "                      smaller: every tag takes 8 bytes) and mesh.vtu with its arrays\n"
     "                      as raw appended binary (faster, about half the size)\n"
+    "  --figures MODE      all | none | auto (default): figures/section-x.svg, -y, -z (the\n"
+    "                      solid cut by three planes through the middle, each element\n"
+    "                      coloured by its smallest dihedral angle, the surface's cut in\n"
+    "                      black) and figures/interface.svg (the BE mesh seen from a\n"
+    "                      corner); auto leaves out a figure of more than 60000 polygons\n"
+    "                      (figures/README.txt says which)\n"
+    "  --no-figures        same as --figures none\n"
     "  --allow-invalid     write the mesh even if validation fails (exit status 1 still)\n"
     "  --quiet             no progress on stderr\n\n"
     "Bad input (open, non-manifold or self-intersecting surface, unreadable file) exits with\n"
@@ -173,11 +187,11 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 int run(const std::vector<std::string>& argv) {
   const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
-                   "--binary"},
+                   "--binary", "--no-figures"},
                   {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
                    "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
-                   "--flat-buffer", "--flat-retry-below"});
+                   "--flat-buffer", "--flat-retry-below", "--figures"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -215,6 +229,8 @@ int run(const std::vector<std::string>& argv) {
   const std::string elements = args.choice_or("--elements", "tet", {"tet", "hex"});
   opt.hex_dominant = elements == "hex";
   const MshEncoding encoding = args.has("--binary") ? MshEncoding::Binary : MshEncoding::Ascii;
+  const std::string figures =
+      args.has("--no-figures") ? "none" : args.choice_or("--figures", "auto", {"all", "none", "auto"});
   const bool quiet = args.has("--quiet");
   const Progress progress("mesh3d", quiet);
 
@@ -268,6 +284,15 @@ int run(const std::vector<std::string>& argv) {
   if (!vr.valid && !args.has("--allow-invalid"))
     throw GeometryError(input + ": the mesh is not valid:\n" + vr.summary());
   writing.get();  // rethrows a write error (one thread: writes now)
+  dim3::MeshFigures drawn;
+  double t_figures = 0.0;
+  if (figures != "none") {
+    progress("figures: sections and the BE mesh");
+    const auto tf = std::chrono::steady_clock::now();
+    drawn = dim3::write_mesh_figures(mesh, surface.surface(), dir.file("figures"),
+                                     figures == "all" ? 0 : auto_figures_max_shapes);
+    t_figures = std::chrono::duration<double>(std::chrono::steady_clock::now() - tf).count();
+  }
 
   nlohmann::json rep;
   rep["input"] = input;
@@ -288,6 +313,7 @@ int run(const std::vector<std::string>& argv) {
                     {"threads", opt.n_threads},
                     {"msh_encoding", encoding == MshEncoding::Binary ? "binary" : "ascii"},
                     {"vtu_encoding", encoding == MshEncoding::Binary ? "binary" : "ascii"},
+                    {"figures", figures},
                     {"buffer_rule_dropped", r.buffer_dropped},
                     {"buffer_rule_fallback", r.buffer_fallback},
                     {"feature_snapping_dropped", r.features_dropped},
@@ -370,6 +396,7 @@ int run(const std::vector<std::string>& argv) {
   // replaced: `how` in the options) took the rest of the pipeline's time.
   times["tries_not_kept"] = std::max(0.0, t_mesh - in_stages);
   times["validate_and_measure"] = t_check;
+  times["figures"] = t_figures;
   // Reading to the report, writing mesh.msh and mesh.vtu included.
   times["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rep["timings_s"] = times;
@@ -433,6 +460,12 @@ int run(const std::vector<std::string>& argv) {
     std::cerr << "febemesh mesh3d: warning: " << w << "\n";
   }
   rep["warnings"] = warnings;
+  {
+    nlohmann::json names = nlohmann::json::array(), skipped = nlohmann::json::array();
+    for (const auto& f : drawn.written) names.push_back(f.string());
+    for (const auto& why : drawn.skipped) skipped.push_back(why);
+    rep["figures"] = {{"drawn", names}, {"skipped", skipped}};
+  }
 
   {
     std::ofstream os(dir.file("report.json"));

@@ -119,6 +119,29 @@ TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary, and mesh.vtu 
   CHECK(runs.report("a")["options"]["vtu_encoding"] == "ascii");
 }
 
+TEST_CASE("mesh3d draws the sections and the BE mesh into figures/; --figures none draws nothing", "[cli][mesh3d]") {
+  const SpherePair runs("figures", 3, "--figures none");  // a: auto
+  const char* names[] = {"section-x.svg", "section-y.svg", "section-z.svg", "interface.svg"};
+  for (const char* name : names) {
+    const std::string svg = read_text(runs.dir / "a" / "figures" / name);
+    CHECK(svg.find("<svg") != std::string::npos);
+    CHECK(svg.find("<polygon") != std::string::npos);
+  }
+  CHECK(read_text(runs.dir / "a" / "figures" / "section-x.svg").find("solid cut by the plane x = ") != std::string::npos);
+  CHECK(!std::filesystem::exists(runs.dir / "a" / "figures" / "README.txt"));  // nothing left out
+  CHECK(!std::filesystem::exists(runs.dir / "b" / "figures"));
+  const auto a = runs.report("a"), b = runs.report("b");
+  CHECK(a["options"]["figures"] == "auto");
+  CHECK(b["options"]["figures"] == "none");
+  CHECK(a["figures"]["drawn"].size() == 4);
+  CHECK(b["figures"]["drawn"].empty());
+  CHECK(a["timings_s"]["figures"].get<double>() > 0.0);
+  CHECK(read_text(runs.msh("a")) == read_text(runs.msh("b")));  // the pictures change nothing else
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  CHECK(run_status("mesh3d '" + sphere + "' -o '" + (runs.dir / "c").string() + "' --figures some") == 2);
+  CHECK(!std::filesystem::exists(runs.dir / "c"));
+}
+
 TEST_CASE("mesh3d tries without the buffer rule first; --buffer-first restores the buffer rule's try first", "[cli][mesh3d]") {
   // sphere966 at level 4: every try stands at once, so the first try of each order makes the
   // mesh: without the buffer rule by default (no octant dropped by it), with it under
