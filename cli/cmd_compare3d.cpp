@@ -1,6 +1,8 @@
 // febemesh compare3d: our octree pipeline against TetGen on the same closed surface (issue 7).
 
 #include <iostream>
+#include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -10,12 +12,18 @@
 #include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
+#include "core/read_msh.hpp"
 #include "dim3/compare_tetgen.hpp"
+#include "dim3/figures3d.hpp"
+#include "dim3/read_surface.hpp"
 
 namespace febemesh::cli {
 namespace {
 
 using namespace febemesh::dim3;
+
+/// A section figure of more polygons than this is not drawn (as mesh3d --figures auto).
+constexpr std::size_t max_section_polygons = 60000;
 
 const char* const help = R"(usage: febemesh compare3d SURFACE -o DIR [options]
 
@@ -36,7 +44,10 @@ options:
 outputs in DIR: mesh.msh (ours, if it meshed), tetgen.msh, tetgen.log, comparison.json ({"febemesh": {..},
 "tetgen": {..}}: elements, nodes, wall_seconds, elements_per_second, peak_memory_bytes,
 min_dihedral_deg, max_dihedral_deg, slivers_below_10deg, volume_rel_error, hausdorff_rel, ...),
-comparison.md, min-dihedral.svg, max-dihedral.svg, radius-ratio.svg, scaled-jacobian.svg.
+comparison.md, min-dihedral.svg, max-dihedral.svg, radius-ratio.svg, scaled-jacobian.svg, and
+febemesh-section-x.svg (-y, -z) and tetgen-section-x.svg (-y, -z): both meshes cut by the same
+three planes (mesh3d's figures), each cut tetrahedron coloured by its smallest dihedral angle
+(a cut of more than 60000 polygons is left out; comparison.md says so).
 Each tool runs single-threaded in a forked child, timed from reading the file to writing its
 .msh; peak_memory_bytes is the child's peak resident memory growth. A tool that fails is
 reported with "ok": false and its message verbatim (libtet 1.5 can crash while failing: then
@@ -125,6 +136,26 @@ int run(const std::vector<std::string>& argv) {
     sj.series.emplace_back(tool, m->element_scaled_jacobian);
   }
   report.plots = {std::move(mind), std::move(maxd), std::move(rr), std::move(sj)};
+  // Both meshes cut by the same planes: where each tool's slivers lie, and what it left out.
+  {
+    const Surface surface(read_surface(input));
+    std::ostringstream md;
+    md << "\n## Sections\n\nBoth meshes cut by the same planes (each cut tetrahedron coloured by its smallest "
+          "dihedral angle; black: the surface's cut):\n\n";
+    for (const auto& [tool, file, ok] : {std::tuple{"febemesh", "mesh.msh", c.febemesh.ok},
+                                         std::tuple{"tetgen", "tetgen.msh", c.tetgen.ok}}) {
+      if (!ok) continue;
+      const Mesh<3> mesh = read_msh<3>(dir.file(file));
+      for (int axis = 0; axis < 3; ++axis) {
+        const std::string name = std::string(tool) + "-section-" + "xyz"[axis] + ".svg";
+        const std::size_t n = write_section_figure(mesh, surface, axis, dir.file(name), max_section_polygons,
+                                                   std::string(tool) == "tetgen" ? "TetGen" : "febemesh");
+        if (n <= max_section_polygons) md << "- " << tool << ", plane " << "xyz"[axis] << ": [" << name << "](" << name << ")\n";
+        else md << "- " << tool << ", plane " << "xyz"[axis] << ": " << n << " polygons, over the limit of " << max_section_polygons << ", not drawn\n";
+      }
+    }
+    report.notes = md.str();
+  }
   return finish_comparison(dir, report, quiet);
 }
 

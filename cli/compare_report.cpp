@@ -132,6 +132,7 @@ int finish_comparison(AtomicOutputDir& dir, const ComparisonOutput& out, bool qu
       if (!quiet) std::cerr << out.command << ": warning: " << w.str() << "\n";
     }
   }
+  md += out.notes;
   write_text(dir.file("comparison.json"), json.dump(2) + "\n");
   write_text(dir.file("comparison.md"), md);
   for (const HistogramPlot& p : out.plots)

@@ -45,6 +45,7 @@ struct ComparisonOutput {
   std::vector<std::string> tools;    ///< e.g. {"febemesh", "gmsh"}
   std::vector<std::string> keys;     ///< rows of comparison.md
   std::vector<HistogramPlot> plots;
+  std::string notes;                 ///< markdown appended to comparison.md (e.g. the figures it names)
   std::string unit = "elements";     ///< for the progress lines: "elements", "tets"
   std::string quality_key;           ///< reported in the progress lines, e.g. "min_angle_deg"
   /// Accepted relative difference of the element counts. When json's "element_count_ratio"

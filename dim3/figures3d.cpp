@@ -160,7 +160,7 @@ void legend(SvgCanvas& c, const Box<2>& box, double below, const std::vector<std
 }
 
 void draw_section(const Mesh<3>& m, const Surface& s, int axis, double at, const std::vector<SectionPolygon>& polys,
-                  const std::filesystem::path& file) {
+                  const std::filesystem::path& file, const std::string& who) {
   SvgCanvas c(900.0, 16.0);
   std::array<std::size_t, n_angle_bins> count{};
   Box<2> box = Box<2>::empty();
@@ -186,7 +186,7 @@ void draw_section(const Mesh<3>& m, const Surface& s, int axis, double at, const
   if (!(box.lo.array() <= box.hi.array()).all()) box = Box<2>{P2::Zero(), P2::Ones()};
   std::ostringstream title;
   title.precision(6);
-  title << "solid cut by the plane " << axis_name(axis) << " = " << at << ": " << polys.size()
+  title << who << (who.empty() ? "solid" : ": solid") << " cut by the plane " << axis_name(axis) << " = " << at << ": " << polys.size()
         << " elements; black: the surface's cut";
   const double below = caption(c, box, {title.str(), "elements by their smallest dihedral angle:"});
   std::vector<std::pair<std::string, std::string>> items;
@@ -322,25 +322,33 @@ std::vector<std::array<Point<2>, 2>> section_segments(const Surface& s, int axis
   return out;
 }
 
+double section_plane(const Surface& s, int axis) {
+  Box<3> box = Box<3>::empty();
+  for (const P3& p : s.vertices()) box.expand(p);
+  return 0.5 * (box.lo[axis] + box.hi[axis]) + 0.0123 * (box.hi[axis] - box.lo[axis]);
+}
+
+std::size_t write_section_figure(const Mesh<3>& m, const Surface& s, int axis, const std::filesystem::path& file,
+                                 std::size_t max_shapes, const std::string& who) {
+  const double at = section_plane(s, axis);
+  const std::vector<SectionPolygon> polys = section_polygons(m, axis, at);
+  if (max_shapes == 0 || polys.size() <= max_shapes) draw_section(m, s, axis, at, polys, file, who);
+  return polys.size();
+}
+
 MeshFigures write_mesh_figures(const Mesh<3>& m, const Surface& s, const std::filesystem::path& dir,
                                std::size_t max_shapes) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError(dir.string() + ": cannot create the figures folder: " + ec.message());
   MeshFigures out;
-  Box<3> box = Box<3>::empty();
-  for (const P3& p : s.vertices()) box.expand(p);
   for (int axis = 0; axis < 3; ++axis) {
-    const double at = 0.5 * (box.lo[axis] + box.hi[axis]) + 0.0123 * (box.hi[axis] - box.lo[axis]);
     const std::string name = std::string("section-") + axis_name(axis) + ".svg";
-    const std::vector<SectionPolygon> polys = section_polygons(m, axis, at);
-    if (max_shapes > 0 && polys.size() > max_shapes) {
-      out.skipped.push_back(name + ": " + std::to_string(polys.size()) + " polygons, over the limit of " +
-                            std::to_string(max_shapes));
-      continue;
-    }
-    draw_section(m, s, axis, at, polys, dir / name);
-    out.written.emplace_back(name);
+    const std::size_t n = write_section_figure(m, s, axis, dir / name, max_shapes);
+    if (max_shapes > 0 && n > max_shapes)
+      out.skipped.push_back(name + ": " + std::to_string(n) + " polygons, over the limit of " + std::to_string(max_shapes));
+    else
+      out.written.emplace_back(name);
   }
   const std::size_t n_skipped = out.skipped.size();
   draw_interface(m, dir / "interface.svg", max_shapes, out.skipped);

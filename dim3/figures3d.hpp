@@ -41,15 +41,24 @@ std::vector<SectionPolygon> section_polygons(const Mesh<3>& m, int axis, double 
 /// nodes on both sides of it.
 std::vector<std::array<Point<2>, 2>> section_segments(const Surface& s, int axis, double at);
 
+/// The plane the figures cut along `axis` at: the middle of the surface's box, moved off it by
+/// 1.23% of the box so that it crosses the octants instead of running along their faces.
+double section_plane(const Surface& s, int axis);
+
+/// The solid cut by the plane x[axis] = section_plane(s, axis), drawn into `file`: each cut
+/// element a polygon coloured by its smallest dihedral angle (with a legend of the counts), the
+/// surface's cut over them in black; `who` (e.g. "TetGen") opens the title. Returns the number
+/// of polygons; the figure is drawn only when that is at most `max_shapes` (0: no limit).
+std::size_t write_section_figure(const Mesh<3>& m, const Surface& s, int axis, const std::filesystem::path& file,
+                                 std::size_t max_shapes, const std::string& who = "");
+
 /// What write_mesh_figures drew and what it left out (and why).
 struct MeshFigures {
   std::vector<std::filesystem::path> written;  ///< file names in the folder
   std::vector<std::string> skipped;            ///< "section-x.svg: 81234 polygons, over the limit of 60000"
 };
 
-/// Writes section-x.svg, section-y.svg, section-z.svg (the cuts by the planes through the middle
-/// of the surface's box, moved off it by 1.23% of the box so that they cross the octants instead
-/// of running along their faces) and interface.svg (the BE mesh from the corner (+x, -y, +z)
+/// Writes section-x.svg, section-y.svg, section-z.svg (write_section_figure) and interface.svg (the BE mesh from the corner (+x, -y, +z)
 /// of the box, hidden faces left out) into `dir` (created). A figure of more than `max_shapes`
 /// polygons is not drawn (0: no limit); README.txt in `dir` then says which and why.
 MeshFigures write_mesh_figures(const Mesh<3>& m, const Surface& s, const std::filesystem::path& dir,

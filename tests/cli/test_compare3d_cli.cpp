@@ -72,6 +72,25 @@ TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both to
                         "scaled-jacobian.svg", "mesh.msh", "tetgen.msh", "tetgen.log"})
     CHECK(std::filesystem::exists(out / f));
   CHECK(read_text(out / "comparison.md").find("Warning") == std::string::npos);
+  // Both meshes cut by the same planes, named in comparison.md.
+  const std::string md = read_text(out / "comparison.md");
+  for (const char* tool : {"febemesh", "tetgen"})
+    for (const char* axis : {"x", "y", "z"}) {
+      const std::string name = std::string(tool) + "-section-" + axis + ".svg";
+      const std::string svg = read_text(out / name);
+      CHECK(svg.find("<polygon") != std::string::npos);
+      CHECK(svg.find(std::string(tool) == "tetgen" ? "TetGen: solid cut by the plane " + std::string(axis)
+                                                   : "febemesh: solid cut by the plane " + std::string(axis)) !=
+            std::string::npos);
+      CHECK(md.find("[" + name + "](" + name + ")") != std::string::npos);
+    }
+  // The same plane in both: the titles' "x = ..." agree.
+  const auto plane = [&](const std::string& name) {
+    const std::string svg = read_text(out / name);
+    const auto at = svg.find("cut by the plane ");
+    return svg.substr(at, svg.find(':', at) - at);
+  };
+  CHECK(plane("febemesh-section-z.svg") == plane("tetgen-section-z.svg"));
   std::filesystem::remove_all(out);
 }
 
