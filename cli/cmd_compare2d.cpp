@@ -1,7 +1,9 @@
 // febemesh compare2d: our 2D pipeline against Gmsh on the same exact curves (issue 7).
 
 #include <iostream>
+#include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -11,14 +13,19 @@
 #include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
+#include "core/read_msh.hpp"
 #include "dim2/compare_gmsh.hpp"
 #include "dim2/curve_boundary.hpp"
+#include "dim2/figures2d.hpp"
 #include "dim2/read_domain.hpp"
 
 namespace febemesh::cli {
 namespace {
 
 using namespace febemesh::dim2;
+
+/// A mesh of more elements than this is not drawn (as mesh2d --figures auto).
+constexpr std::size_t max_drawn_elements = 20000;
 
 const char* const help = R"(usage: febemesh compare2d INPUT -o DIR [options]
 
@@ -41,7 +48,9 @@ options:
 
 outputs in DIR: mesh.msh (ours), gmsh.geo, gmsh.msh, gmsh.log, comparison.json ({"febemesh": {..},
 "gmsh": {..}}: elements, nodes, wall_seconds, elements_per_second, min_angle_deg, max_angle_deg,
-area_rel_error, hausdorff_rel, ...), comparison.md, min-angle.svg (0-60 deg for tri, 0-90 for quad/mixed), scaled-jacobian.svg.
+area_rel_error, hausdorff_rel, ...), comparison.md, min-angle.svg (0-60 deg for tri, 0-90 for quad/mixed), scaled-jacobian.svg, and
+febemesh-mesh.svg and gmsh-mesh.svg: both meshes, each element filled by its smallest corner
+angle (up to 20000 elements; comparison.md says when they are not drawn).
 Both tools run single-threaded; our wall time is mesh2d + writing mesh.msh, Gmsh's is its whole
 run as a subprocess. A tool that fails is reported with "ok": false and its message verbatim.
 exit status: 0 both tools meshed, 1 bad input or a tool failed, 2 bad usage.
@@ -132,6 +141,27 @@ int run(const std::vector<std::string>& argv) {
     jac.series.emplace_back(tool, m->element_scaled_jacobian);
   }
   report.plots = {std::move(angles), std::move(jac)};
+  // Both meshes drawn in the curve's box, each element by its smallest angle (where they can
+  // still be read, as mesh2d's figures).
+  {
+    std::ostringstream md;
+    md << "\n## Meshes\n\nEach element filled by its smallest corner angle (blue: the curve):\n\n";
+    for (const auto& [tool, file, ok] : {std::tuple{"febemesh", "mesh.msh", c.febemesh.ok},
+                                         std::tuple{"gmsh", "gmsh.msh", c.gmsh.ok}}) {
+      if (!ok) continue;
+      const Mesh<2> mesh = read_msh<2>(dir.file(file));
+      const std::string name = std::string(tool) + "-mesh.svg";
+      if (mesh.solid.size() <= max_drawn_elements) {
+        draw_angle_figure(mesh, curve, dir.file(name), std::string(tool) == "gmsh" ? "Gmsh" : "febemesh",
+                          opt.elements != ElementKind::Tri);
+        md << "- " << tool << ": [" << name << "](" << name << ")\n";
+      } else {
+        md << "- " << tool << ": " << mesh.solid.size() << " elements, over the " << max_drawn_elements
+           << " drawn (an SVG of that many cannot be read), not drawn\n";
+      }
+    }
+    report.notes = md.str();
+  }
   return finish_comparison(dir, report, quiet);
 }
 

@@ -1,10 +1,13 @@
 #include "dim2/figures2d.hpp"
 
+#include <array>
 #include <cstdio>
 #include <fstream>
 #include <span>
+#include <string>
 
 #include "core/error.hpp"
+#include "core/quality.hpp"
 #include "core/svg_canvas.hpp"
 #include "dim2/loop_geometry.hpp"
 
@@ -192,6 +195,46 @@ std::vector<fs::path> write_stage_figures(const Result2d& r, const CurveBoundary
     save(c, dir, "08-final-mesh.svg", written);
   }
   return written;
+}
+
+void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::path& file, const std::string& who,
+                       bool quads) {
+  // Bins of the smallest corner angle, up to the best shape's (60 deg for triangles, 90 for quads).
+  const std::array<double, 4> upper = quads ? std::array<double, 4>{30, 45, 60, 75} : std::array<double, 4>{20, 30, 40, 50};
+  const std::array<const char*, 5> fill = {"#d62728", "#ff7f0e", "#f2c94c", "#9ed89e", "#2ca02c"};
+  std::array<std::size_t, 5> count{};
+  SvgCanvas c;
+  const Box<2> view = curve.root_box();
+  const double h = view.hi[1] - view.lo[1], w = view.hi[0] - view.lo[0];
+  // Strips above it for the title and under it for the legend.
+  c.set_view(Box<2>{P2(view.lo[0], view.lo[1] - 0.07 * h), P2(view.hi[0], view.hi[1] + 0.04 * h)});
+  const bool edges = m.solid.size() <= 20000;
+  for (std::size_t e = 0; e < m.solid.size(); ++e) {
+    const ElemId id{static_cast<std::int32_t>(e)};
+    const ElemPoints<2> ep = element_points<2>(m.solid, id, m.points);
+    const double deg = element_quality<2>(m.solid.type[e], ep.span()).min_angle_deg;
+    std::size_t b = 0;
+    while (b < upper.size() && !(deg < upper[b])) ++b;
+    ++count[b];
+    c.polygon(std::vector<P2>(ep.p.begin(), ep.p.begin() + ep.n), {fill[b], edges ? "#555555" : "none", 0.3, 1.0});
+  }
+  draw_curve(c, curve, 1.0);
+  c.text(P2(view.lo[0], view.hi[1] + 0.015 * h), (who.empty() ? "" : who + ": ") + std::to_string(m.solid.size()) +
+                                          " elements by their smallest corner angle; blue: the curve",
+         14.0, ink);
+  for (std::size_t b = 0; b < fill.size(); ++b) {
+    const double x = view.lo[0] + w * static_cast<double>(b) / 5.0, y = view.lo[1] - 0.055 * h, side = 0.025 * h;
+    c.polygon({P2(x, y), P2(x + side, y), P2(x + side, y + side), P2(x, y + side)}, {fill[b], "#555555", 0.5, 1.0});
+    char label[64];
+    if (b == 0)
+      std::snprintf(label, sizeof label, "< %g deg: %zu", upper[0], count[b]);
+    else if (b == upper.size())
+      std::snprintf(label, sizeof label, ">= %g deg: %zu", upper[b - 1], count[b]);
+    else
+      std::snprintf(label, sizeof label, "%g-%g deg: %zu", upper[b - 1], upper[b], count[b]);
+    c.text(P2(x + 1.4 * side, y), label, 12.0, ink);
+  }
+  c.write(file);
 }
 
 }  // namespace febemesh::dim2

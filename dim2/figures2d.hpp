@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "dim2/curve_boundary.hpp"
@@ -22,5 +23,12 @@ void write_figures_skipped_note(const std::filesystem::path& dir, std::size_t n_
 
 /// The curve with its control polygon and corners (the paper's Figures 1-2).
 void draw_geometry_figure(const CurveBoundary& curve, const std::filesystem::path& file);
+
+/// The mesh with each element filled by the bin of its smallest corner angle (five bins up to
+/// the best shape's: 20/30/40/50 deg for triangles, 30/45/60/75 with `quads`, a legend with the
+/// counts under it), element outlines up to 20,000 elements, the curve over it; `who` (e.g.
+/// "Gmsh") opens the title. In the curve's root box, so two meshes of one curve line up.
+void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const std::filesystem::path& file,
+                       const std::string& who, bool quads);
 
 }  // namespace febemesh::dim2

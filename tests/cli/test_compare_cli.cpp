@@ -64,6 +64,25 @@ TEST_CASE("compare2d on the flange matches Gmsh's element count and reports both
   std::stringstream ss;
   ss << geo.rdbuf();
   CHECK(ss.str().find("Bezier(") != std::string::npos);
+  // Both meshes drawn, every element counted once in the legend's bins, named in comparison.md.
+  std::ifstream md_in(out / "comparison.md");
+  std::stringstream md;
+  md << md_in.rdbuf();
+  for (const char* tool : {"febemesh", "gmsh"}) {
+    INFO(tool);
+    const std::string name = std::string(tool) + "-mesh.svg";
+    std::ifstream svg_in(out / name);
+    std::stringstream svg;
+    svg << svg_in.rdbuf();
+    const std::string text = svg.str();
+    CHECK(text.find("<polygon") != std::string::npos);
+    std::size_t counted = 0, bins = 0;
+    for (std::size_t at = text.find(" deg: "); at != std::string::npos; at = text.find(" deg: ", at + 1), ++bins)
+      counted += std::stoul(text.substr(at + 6));
+    CHECK(bins == 5);
+    CHECK(counted == j[tool]["elements"].get<std::size_t>());
+    CHECK(md.str().find("[" + name + "](" + name + ")") != std::string::npos);
+  }
   std::filesystem::remove_all(out.parent_path());
 }
 
@@ -78,6 +97,8 @@ TEST_CASE("compare2d reports a failing Gmsh and exits with status 1", "[cli][com
   CHECK(j["febemesh"]["ok"] == true);
   CHECK(j["gmsh"]["ok"] == false);
   CHECK(j["gmsh"]["error"].get<std::string>().find("/nonexistent/gmsh") != std::string::npos);
+  CHECK(std::filesystem::exists(out / "febemesh-mesh.svg"));
+  CHECK(!std::filesystem::exists(out / "gmsh-mesh.svg"));
   std::filesystem::remove_all(out.parent_path());
 }
 
