@@ -152,8 +152,7 @@ int run(const std::vector<std::string>& argv) {
       const Mesh<2> mesh = read_msh<2>(dir.file(file));
       const std::string name = std::string(tool) + "-mesh.svg";
       if (mesh.solid.size() <= max_drawn_elements) {
-        draw_angle_figure(mesh, curve, dir.file(name), std::string(tool) == "gmsh" ? "Gmsh" : "febemesh",
-                          opt.elements != ElementKind::Tri);
+        draw_angle_figure(mesh, curve, dir.file(name), std::string(tool) == "gmsh" ? "Gmsh" : "febemesh");
         md << "- " << tool << ": [" << name << "](" << name << ")\n";
       } else {
         md << "- " << tool << ": " << mesh.solid.size() << " elements, over the " << max_drawn_elements

@@ -194,15 +194,20 @@ std::vector<fs::path> write_stage_figures(const Result2d& r, const CurveBoundary
                           std::to_string(m.points.size()) + " nodes");
     save(c, dir, "08-final-mesh.svg", written);
   }
+  {
+    const Mesh<2>& m = r.fe.mesh;
+    draw_angle_figure(m, curve, dir / "09-angles.svg", "");
+    written.push_back(dir / "09-angles.svg");
+  }
   return written;
 }
 
-void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::path& file, const std::string& who,
-                       bool quads) {
-  // Bins of the smallest corner angle, up to the best shape's (60 deg for triangles, 90 for quads).
-  const std::array<double, 4> upper = quads ? std::array<double, 4>{30, 45, 60, 75} : std::array<double, 4>{20, 30, 40, 50};
+void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::path& file, const std::string& who) {
+  // Bins of the smallest corner angle up to the best shape's: 60 deg for a triangle, 90 for a quad.
+  const std::array<double, 4> tri_upper{20, 30, 40, 50}, quad_upper{30, 45, 60, 75};
   const std::array<const char*, 5> fill = {"#d62728", "#ff7f0e", "#f2c94c", "#9ed89e", "#2ca02c"};
   std::array<std::size_t, 5> count{};
+  bool any_tri = false, any_quad = false;
   SvgCanvas c;
   const Box<2> view = curve.root_box();
   const double h = view.hi[1] - view.lo[1], w = view.hi[0] - view.lo[0];
@@ -212,6 +217,9 @@ void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::p
   for (std::size_t e = 0; e < m.solid.size(); ++e) {
     const ElemId id{static_cast<std::int32_t>(e)};
     const ElemPoints<2> ep = element_points<2>(m.solid, id, m.points);
+    const bool quad = m.solid.type[e] == ElemType::Quad4;
+    (quad ? any_quad : any_tri) = true;
+    const std::array<double, 4>& upper = quad ? quad_upper : tri_upper;
     const double deg = element_quality<2>(m.solid.type[e], ep.span()).min_angle_deg;
     std::size_t b = 0;
     while (b < upper.size() && !(deg < upper[b])) ++b;
@@ -219,20 +227,28 @@ void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::p
     c.polygon(std::vector<P2>(ep.p.begin(), ep.p.begin() + ep.n), {fill[b], edges ? "#555555" : "none", 0.3, 1.0});
   }
   draw_curve(c, curve, 1.0);
-  c.text(P2(view.lo[0], view.hi[1] + 0.015 * h), (who.empty() ? "" : who + ": ") + std::to_string(m.solid.size()) +
-                                          " elements by their smallest corner angle; blue: the curve",
+  const std::string kinds = any_tri && any_quad ? " (triangles / quads)" : "";
+  c.text(P2(view.lo[0], view.hi[1] + 0.015 * h),
+         (who.empty() ? "" : who + ": ") + std::to_string(m.solid.size()) + " elements by their smallest corner angle" +
+             kinds + "; blue: the curve",
          14.0, ink);
+  // A bin's label: its range for the kinds the mesh has ("20-30 / 30-45 deg" when both).
+  const auto range = [](const std::array<double, 4>& upper, std::size_t b) {
+    char text[32];
+    if (b == 0)
+      std::snprintf(text, sizeof text, "< %g", upper[0]);
+    else if (b == upper.size())
+      std::snprintf(text, sizeof text, ">= %g", upper[b - 1]);
+    else
+      std::snprintf(text, sizeof text, "%g-%g", upper[b - 1], upper[b]);
+    return std::string(text);
+  };
   for (std::size_t b = 0; b < fill.size(); ++b) {
     const double x = view.lo[0] + w * static_cast<double>(b) / 5.0, y = view.lo[1] - 0.055 * h, side = 0.025 * h;
     c.polygon({P2(x, y), P2(x + side, y), P2(x + side, y + side), P2(x, y + side)}, {fill[b], "#555555", 0.5, 1.0});
-    char label[64];
-    if (b == 0)
-      std::snprintf(label, sizeof label, "< %g deg: %zu", upper[0], count[b]);
-    else if (b == upper.size())
-      std::snprintf(label, sizeof label, ">= %g deg: %zu", upper[b - 1], count[b]);
-    else
-      std::snprintf(label, sizeof label, "%g-%g deg: %zu", upper[b - 1], upper[b], count[b]);
-    c.text(P2(x + 1.4 * side, y), label, 12.0, ink);
+    std::string label = any_quad && !any_tri ? range(quad_upper, b) : range(tri_upper, b);
+    if (any_tri && any_quad) label += " / " + range(quad_upper, b);
+    c.text(P2(x + 1.4 * side, y), label + " deg: " + std::to_string(count[b]), 12.0, ink);
   }
   c.write(file);
 }

@@ -2,7 +2,7 @@
 // The paper's Figures 1-12 for a run of the 2D pipeline: one legible, colour-coded SVG per
 // stage (control points and curve, quadrants after subdivision, after the one-level-difference
 // rule, interior quadrants, boundary quadrants, after corner pulling, after smoothing, boundary
-// elements, the final mesh).
+// elements, the final mesh), and the final mesh coloured by its elements' smallest angles.
 
 #include <cstddef>
 #include <filesystem>
@@ -25,10 +25,11 @@ void write_figures_skipped_note(const std::filesystem::path& dir, std::size_t n_
 void draw_geometry_figure(const CurveBoundary& curve, const std::filesystem::path& file);
 
 /// The mesh with each element filled by the bin of its smallest corner angle (five bins up to
-/// the best shape's: 20/30/40/50 deg for triangles, 30/45/60/75 with `quads`, a legend with the
-/// counts under it), element outlines up to 20,000 elements, the curve over it; `who` (e.g.
-/// "Gmsh") opens the title. In the curve's root box, so two meshes of one curve line up.
+/// the best shape's: 20/30/40/50 deg for a triangle, 30/45/60/75 for a quad; a legend with the
+/// counts under it, both ranges where the mesh has both kinds), element outlines up to 20,000
+/// elements, the curve over it; `who` (e.g. "Gmsh") opens the title. In the curve's root box,
+/// so two meshes of one curve line up.
 void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const std::filesystem::path& file,
-                       const std::string& who, bool quads);
+                       const std::string& who);
 
 }  // namespace febemesh::dim2

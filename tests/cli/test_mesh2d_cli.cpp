@@ -88,6 +88,13 @@ TEST_CASE("mesh2d's report counts the stages whether or not it kept them for the
   const auto kept = nlohmann::json::parse(read_text(dir / "auto" / "report.json"));
   const auto dropped = nlohmann::json::parse(read_text(dir / "none" / "report.json"));
   CHECK(std::filesystem::exists(dir / "auto" / "figures"));
+  // The last figure: every element filled by its smallest angle, each counted once in the legend.
+  const std::string angles = read_text(dir / "auto" / "figures" / "09-angles.svg");
+  std::size_t counted = 0, bins = 0;
+  for (std::size_t at = angles.find(" deg: "); at != std::string::npos; at = angles.find(" deg: ", at + 1), ++bins)
+    counted += std::stoul(angles.substr(at + 6));
+  CHECK(bins == 5);
+  CHECK(counted == kept["counts"]["fe_elements"].get<std::size_t>());
   CHECK(kept["counts"] == dropped["counts"]);
   const auto& c = dropped["counts"];
   CHECK(c["quadrants_subdivided"].get<std::size_t>() > 100);
