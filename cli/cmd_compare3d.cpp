@@ -150,8 +150,11 @@ int run(const std::vector<std::string>& argv) {
         const std::string name = std::string(tool) + "-section-" + "xyz"[axis] + ".svg";
         const std::size_t n = write_section_figure(mesh, surface, axis, dir.file(name), max_section_polygons,
                                                    std::string(tool) == "tetgen" ? "TetGen" : "febemesh");
-        if (n <= max_section_polygons) md << "- " << tool << ", plane " << "xyz"[axis] << ": [" << name << "](" << name << ")\n";
-        else md << "- " << tool << ", plane " << "xyz"[axis] << ": " << n << " polygons, over the limit of " << max_section_polygons << ", not drawn\n";
+        md << "- " << tool << ", plane " << "xyz"[axis] << ": ";
+        if (n <= max_section_polygons)
+          md << "[" << name << "](" << name << ")\n";
+        else
+          md << n << " polygons, over the limit of " << max_section_polygons << ", not drawn\n";
       }
     }
     report.notes = md.str();

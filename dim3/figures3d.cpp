@@ -165,10 +165,13 @@ void draw_section(const Mesh<3>& m, const Surface& s, int axis, double at, const
   std::array<std::size_t, n_angle_bins> count{};
   Box<2> box = Box<2>::empty();
   const bool edges = polys.size() <= 20000;  // element outlines only where they can be seen
-  for (const SectionPolygon& sp : polys) {
+  std::size_t n_elements = 0;
+  for (std::size_t k = 0; k < polys.size(); ++k) {
+    const SectionPolygon& sp = polys[k];
     const ElemPoints<3> ep = element_points<3>(m.solid, ElemId{sp.element}, m.points);
     const int b = angle_bin(element_quality<3>(m.solid.type[static_cast<std::size_t>(sp.element)], ep.span()).min_angle_deg);
-    ++count[static_cast<std::size_t>(b)];
+    // An element whose cut falls apart has several polygons, one after the other: counted once.
+    if (k == 0 || sp.element != polys[k - 1].element) ++count[static_cast<std::size_t>(b)], ++n_elements;
     SvgStyle st;
     st.fill = angle_bins[b].colour;
     st.stroke = edges ? "#555555" : "none";
@@ -186,8 +189,8 @@ void draw_section(const Mesh<3>& m, const Surface& s, int axis, double at, const
   if (!(box.lo.array() <= box.hi.array()).all()) box = Box<2>{P2::Zero(), P2::Ones()};
   std::ostringstream title;
   title.precision(6);
-  title << who << (who.empty() ? "solid" : ": solid") << " cut by the plane " << axis_name(axis) << " = " << at << ": " << polys.size()
-        << " elements; black: the surface's cut";
+  title << who << (who.empty() ? "solid" : ": solid") << " cut by the plane " << axis_name(axis) << " = " << at << ": "
+        << n_elements << " elements; black: the surface's cut";
   const double below = caption(c, box, {title.str(), "elements by their smallest dihedral angle:"});
   std::vector<std::pair<std::string, std::string>> items;
   for (int b = 0; b < n_angle_bins; ++b)

@@ -124,6 +124,35 @@ TEST_CASE("section_polygons of one tetrahedron: the cut triangle, nothing where 
   CHECK(signed_area(through[0].pts) == Approx(0.5 * 0.75 * 0.75));
 }
 
+TEST_CASE("section_polygons: a thin saddle-shaped hexahedron's cut falls apart in two polygons", "[figures3d]") {
+  // Bottom corners at z 0, 0.2, 0, 0.2 (a saddle), the top 0.02 above: the plane z = 0.09 runs
+  // through the low corners' corners of both faces, which its bilinear faces cut off.
+  Mesh<3> m;
+  const double zb[4] = {0.0, 0.2, 0.0, 0.2};
+  const double xy[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (const double lift : {0.0, 0.02})
+    for (int k = 0; k < 4; ++k) m.add_point(P3(xy[k][0], xy[k][1], zb[k] + lift));
+  m.solid.add(ElemType::Hex8, {VertexId{0}, VertexId{1}, VertexId{2}, VertexId{3}, VertexId{4}, VertexId{5}, VertexId{6},
+                               VertexId{7}});
+  const auto cut = section_polygons(m, 2, 0.09);
+  REQUIRE(cut.size() == 2);
+  for (const SectionPolygon& p : cut) {
+    CHECK(p.element == 0);
+    CHECK(p.pts.size() == 4);
+    CHECK(signed_area(p.pts) > 0);
+  }
+  // One around the corner (0, 0), one around (1, 1), in either order.
+  const auto mean = [](const std::vector<P2>& pts) {
+    P2 c = P2::Zero();
+    for (const P2& p : pts) c += p;
+    return P2(c / static_cast<double>(pts.size()));
+  };
+  const P2 a = mean(cut[0].pts), b = mean(cut[1].pts);
+  const bool first_low = a.norm() < b.norm();
+  CHECK(((first_low ? a : b) - P2(0, 0)).norm() < 0.5);
+  CHECK(((first_low ? b : a) - P2(1, 1)).norm() < 0.5);
+}
+
 TEST_CASE("section_polygons tile the section of a meshed box, tetrahedral and hex-dominant", "[figures3d]") {
   for (const bool hex : {false, true}) {
     const Result3d r = mesh_box(hex);
