@@ -85,7 +85,7 @@ void reexec_with_huge_page_heap(char** argv) {
 
 void set_up_heap(char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
-  if (huge_pages_wanted()) reexec_with_huge_page_heap(argv);
+  if (huge_page_heap_wanted()) reexec_with_huge_page_heap(argv);
   if (!tunable_is_set(std::getenv("GLIBC_TUNABLES"), "glibc.malloc.arena_max")) mallopt(M_ARENA_MAX, 1);
 #else
   (void)argv;

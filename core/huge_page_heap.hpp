@@ -25,19 +25,21 @@ std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 void reexec_with_huge_page_heap(char** argv);
 
 /// The process's malloc set-up; call it first thing in main. On glibc: one arena for every
-/// thread (mallopt, unless GLIBC_TUNABLES sets an arena count), and with FEBEMESH_HUGE_PAGES=1
-/// the restart of reexec_with_huge_page_heap.
+/// thread (mallopt, unless GLIBC_TUNABLES sets an arena count), and, unless
+/// FEBEMESH_HUGE_PAGES=0, the restart of reexec_with_huge_page_heap (huge_page_heap_wanted).
 ///
 /// One arena: with an arena a thread, the second thread's blocks did not reuse what the first
 /// had freed (bench_mesh3d sphere966 L6 on two threads: peak 154 -> 142-144 MB, the same time).
-/// Huge pages only on request: on the Firecracker VM of sessions 22-23 a 4 KiB page's first
+/// Huge pages: on by default since session 41 (measured: core/huge_pages.hpp's
+/// huge_page_heap_wanted); before, on the Firecracker VM of sessions 22-23 a 4 KiB page's first
 /// touch cost ~11 us and the huge-page heap saved 7-8% of the 10^6-element benchmarks; on the
 /// VM of session 25 (free page reporting of 8 MiB blocks to the host, THP defrag on madvise) it
 /// did not pay, in interleaved pairs, one thread: bench_mesh3d sphere966 L6 slower with it in 7
 /// of 7 (4.05-5.43 s wall, system 0.21-1.18 s, against 3.85-4.10 s, 0.05-0.08 s), bench_mesh2d
 /// flange 1e6 in 5 of 7 (4.04-7.95 s against 3.57-5.32 s), the CLI on sphere966 L6 (which
-/// also validates and writes mesh.vtu) in 3 of 7 (5.64-7.34 s against 5.88-6.82 s). The same
-/// variable turns on reserve_huge's advice (core/huge_pages.hpp; off since session 26).
+/// also validates and writes mesh.vtu) in 3 of 7 (5.64-7.34 s against 5.88-6.82 s), so it was
+/// off from session 25 to 40. FEBEMESH_HUGE_PAGES=1 also turns on reserve_huge's advice
+/// (core/huge_pages.hpp; off since session 26).
 void set_up_heap(char** argv);
 
 }  // namespace febemesh

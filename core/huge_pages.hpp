@@ -27,6 +27,23 @@ inline bool huge_pages_wanted() {
   return wanted;
 }
 
+/// Whether malloc's memory should come on transparent huge pages (the restart of
+/// core/huge_page_heap.hpp's set_up_heap): on unless FEBEMESH_HUGE_PAGES=0 (read once); the
+/// large arrays' own advice (huge_pages_wanted) stays off unless FEBEMESH_HUGE_PAGES=1. On since
+/// session 41, when this VM ran faster with it (sessions 25-40: off, when it ran slower):
+/// bench_mesh2d flange 10^6, one thread, eleven alternating rounds, faster in ten (0.464-0.695 s
+/// against 0.601-0.873; in the quietest three 0.476-0.517 against 0.614-0.631); bench_mesh3d
+/// sphere966 at 4,941,815 tets 11.4-12.8 s against 14.7-17.4 (peak 493.9-519.1 against
+/// 478.1-535.3 MB), at 995,249 2.92-3.98 against 3.12-4.62 s (the quietest three 2.92-3.08
+/// against 3.23-3.27; peak 104.9-107.1 against 101.8-101.9 MB). The same meshes.
+inline bool huge_page_heap_wanted() {
+  static const bool wanted = [] {
+    const char* v = std::getenv("FEBEMESH_HUGE_PAGES");
+    return v == nullptr || std::strcmp(v, "0") != 0;
+  }();
+  return wanted;
+}
+
 /// The part [lo, hi) of [p, p + bytes) aligned to `align` (a power of two) at both ends; empty
 /// (hi <= lo) where there is none.
 inline std::pair<std::uintptr_t, std::uintptr_t> aligned_part(const void* p, std::size_t bytes, std::uintptr_t align) {

@@ -140,18 +140,21 @@ TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") 
 }
 
 TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart", "[cli][mesh2d]") {
-  // With FEBEMESH_HUGE_PAGES=1 the program starts itself again with glibc.malloc.hugetlb=1,
-  // unless GLIBC_TUNABLES sets the tunable already: the same arguments, the same mesh. Without
-  // it (the default) no restart; one malloc arena either way, unless GLIBC_TUNABLES sets one.
+  // By default (and with FEBEMESH_HUGE_PAGES=1) the program starts itself again with
+  // glibc.malloc.hugetlb=1, unless GLIBC_TUNABLES sets the tunable already: the same arguments,
+  // the same mesh. With FEBEMESH_HUGE_PAGES=0 no restart; one malloc arena either way, unless
+  // GLIBC_TUNABLES sets one.
   const auto dir = scratch("hugepages");
   const std::string args = "mesh2d '" + flange + "' --level 6 --quiet -o '";
   REQUIRE(run(args + (dir / "default").string() + "'").status == 0);
   REQUIRE(run(args + (dir / "huge").string() + "'", "FEBEMESH_HUGE_PAGES=1").status == 0);
+  REQUIRE(run(args + (dir / "small").string() + "'", "FEBEMESH_HUGE_PAGES=0").status == 0);
   REQUIRE(run(args + (dir / "preset").string() + "'", "FEBEMESH_HUGE_PAGES=1 GLIBC_TUNABLES=glibc.malloc.hugetlb=0").status == 0);
   REQUIRE(run(args + (dir / "arenas").string() + "'", "GLIBC_TUNABLES=glibc.malloc.arena_max=4").status == 0);
   const std::string a = read_text(dir / "default" / "mesh.msh");
   CHECK(a.size() > 10000);
   CHECK(a == read_text(dir / "huge" / "mesh.msh"));
+  CHECK(a == read_text(dir / "small" / "mesh.msh"));
   CHECK(a == read_text(dir / "preset" / "mesh.msh"));
   CHECK(a == read_text(dir / "arenas" / "mesh.msh"));
   const Run help = run("--help");
