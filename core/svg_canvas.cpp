@@ -63,6 +63,16 @@ std::string svg_palette(int i) {
   return colours[((i % n) + n) % n];
 }
 
+void swatch_row(SvgCanvas& c, const Point<2>& first, double slot, double side,
+                const std::vector<std::pair<std::string, std::string>>& items) {
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    const double x = first.x() + slot * static_cast<double>(k), y = first.y();
+    c.polygon({Point<2>(x, y + side), Point<2>(x + side, y + side), Point<2>(x + side, y), Point<2>(x, y)},
+              {items[k].first, "#555555", 0.5, 1.0});
+    c.text(Point<2>(x + 1.4 * side, y), items[k].second, 12.0, "#222222");
+  }
+}
+
 SvgCanvas::SvgCanvas(double width_px, double margin_px) : width_px_(width_px), margin_px_(margin_px) {}
 
 void SvgCanvas::polygon(const std::vector<Point<2>>& pts, const SvgStyle& style) {

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/box.hpp"
@@ -22,6 +23,13 @@ struct SvgStyle {
 std::string svg_rgb(double r, double g, double b);
 /// A colour of a fixed, distinguishable palette (cycles).
 std::string svg_palette(int i);
+
+class SvgCanvas;
+/// A legend's row of colour swatches: item k (its fill colour, its label) a square of `side`
+/// (mesh units) with its lower left corner at first + (k slot, 0), the label after it on the
+/// same baseline (12 px).
+void swatch_row(SvgCanvas& c, const Point<2>& first, double slot, double side,
+                const std::vector<std::pair<std::string, std::string>>& items);
 
 class SvgCanvas {
  public:

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "core/quality.hpp"
@@ -243,13 +244,13 @@ void draw_angle_figure(const Mesh<2>& m, const CurveBoundary& curve, const fs::p
       std::snprintf(text, sizeof text, "%g-%g", upper[b - 1], upper[b]);
     return std::string(text);
   };
+  std::vector<std::pair<std::string, std::string>> items;
   for (std::size_t b = 0; b < fill.size(); ++b) {
-    const double x = view.lo[0] + w * static_cast<double>(b) / 5.0, y = view.lo[1] - 0.055 * h, side = 0.025 * h;
-    c.polygon({P2(x, y), P2(x + side, y), P2(x + side, y + side), P2(x, y + side)}, {fill[b], "#555555", 0.5, 1.0});
     std::string label = any_quad && !any_tri ? range(quad_upper, b) : range(tri_upper, b);
     if (any_tri && any_quad) label += " / " + range(quad_upper, b);
-    c.text(P2(x + 1.4 * side, y), label + " deg: " + std::to_string(count[b]), 12.0, ink);
+    items.emplace_back(fill[b], label + " deg: " + std::to_string(count[b]));
   }
+  swatch_row(c, P2(view.lo[0], view.lo[1] - 0.055 * h), w / static_cast<double>(fill.size()), 0.025 * h, items);
   c.write(file);
 }
 

@@ -39,6 +39,15 @@ std::vector<P2> convex_ring(std::vector<P2> pts) {
   return out;
 }
 
+/// Whether an edge whose ends lie at signed distances da and db from the plane crosses it (its
+/// ends strictly on both sides).
+bool crosses(double da, double db) { return (da < 0 && db > 0) || (da > 0 && db < 0); }
+
+/// Where such an edge ab meets the plane x[axis] = at, in the plane's coordinates.
+P2 plane_point(const P3& a, const P3& b, double da, double db, int axis) {
+  return section_coordinates(a + (da / (da - db)) * (b - a), axis);
+}
+
 /// The crossings of a face's boundary loop by the plane (`d`: the loop's nodes' signed
 /// distances, none 0), paired into the face's segments: two crossings make one; four (a quad
 /// whose corners alternate sides) make two, joined as the bilinear face's cut joins them, around
@@ -49,7 +58,7 @@ std::vector<std::array<int, 2>> face_segments(std::span<const double> d, const C
   const std::size_t n = d.size();
   std::vector<int> found;
   for (std::size_t k = 0; k < n; ++k)
-    if ((d[k] < 0) != (d[(k + 1) % n] < 0)) found.push_back(crossing(k));
+    if (crosses(d[k], d[(k + 1) % n])) found.push_back(crossing(k));
   if (std::find(found.begin(), found.end(), -1) != found.end()) return {};  // not an edge of the element
   if (found.size() == 2) return {{found[0], found[1]}};
   if (found.size() != 4 || n != 4) return {};
@@ -147,16 +156,7 @@ double caption(SvgCanvas& c, const Box<2>& box, const std::vector<std::string>& 
 void legend(SvgCanvas& c, const Box<2>& box, double below, const std::vector<std::pair<std::string, std::string>>& items) {
   const double w = box.hi.x() - box.lo.x(), h = std::max(w, box.hi.y() - box.lo.y());
   const double side = 0.025 * h, y = box.lo.y() - below - 0.01 * h;
-  const double slot = w / static_cast<double>(std::max<std::size_t>(items.size(), 1));
-  for (std::size_t k = 0; k < items.size(); ++k) {
-    const double x = box.lo.x() + slot * static_cast<double>(k);
-    SvgStyle st;
-    st.fill = items[k].first;
-    st.stroke = "#555555";
-    st.stroke_width = 0.5;
-    c.polygon({P2(x, y), P2(x + side, y), P2(x + side, y - side), P2(x, y - side)}, st);
-    c.text(P2(x + 1.4 * side, y - side), items[k].second, 12.0, "#222222");
-  }
+  swatch_row(c, P2(box.lo.x(), y - side), w / static_cast<double>(std::max<std::size_t>(items.size(), 1)), side, items);
 }
 
 void draw_section(const Mesh<3>& m, const Surface& s, int axis, double at, const std::vector<SectionPolygon>& polys,
@@ -293,9 +293,9 @@ std::vector<SectionPolygon> section_polygons(const Mesh<3>& m, int axis, double 
       const auto [i, j] = edge_local_nodes(t, k);
       const P3 &a = m.points[v[i].v], &b = m.points[v[j].v];
       const double da = a[axis] - at, db = b[axis] - at;
-      if (!((da < 0 && db > 0) || (da > 0 && db < 0))) continue;
+      if (!crosses(da, db)) continue;
       edge_nodes.push_back({std::min(i, j), std::max(i, j)});
-      pts.push_back(section_coordinates(a + (da / (da - db)) * (b - a), axis));
+      pts.push_back(plane_point(a, b, da, db, axis));
     }
     std::vector<std::vector<P2>> rings;
     if (!on) rings = chained_rings(m, v, t, axis, at, edge_nodes, pts);
@@ -318,7 +318,7 @@ std::vector<std::array<Point<2>, 2>> section_segments(const Surface& s, int axis
       const P3 &a = s.vertex(t[k]), &b = s.vertex(t[(k + 1) % 3]);
       const double da = a[axis] - at, db = b[axis] - at;
       if (da == 0) pts.push_back(section_coordinates(a, axis));
-      if ((da < 0 && db > 0) || (da > 0 && db < 0)) pts.push_back(section_coordinates(a + (da / (da - db)) * (b - a), axis));
+      if (crosses(da, db)) pts.push_back(plane_point(a, b, da, db, axis));
     }
     if (pts.size() == 2) out.push_back({pts[0], pts[1]});
   }
