@@ -203,7 +203,8 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   try {
     return mesh3d_tries(s, opt, effort, progress);
   } catch (const GeometryError& e) {
-    if (opt.raise_levels <= 0 || effort.used >= opt.min_effort_octants) throw;
+    effort.refused_cheaply = effort.used < opt.min_effort_octants;
+    if (opt.raise_levels <= 0 || !effort.refused_cheaply) throw;
     if (progress) progress("refused at level " + std::to_string(opt.level) + " (" + e.what() + "): once more at level " +
                            std::to_string(opt.level + 1));
     Options3d finer = opt;
@@ -395,15 +396,18 @@ struct Drawn {
   double error = std::numeric_limits<double>::infinity();  ///< volume error
   std::string degraded;                                   ///< how, for the progress report
   int draw = 0;                                           ///< lattice_draw_shift(draw)
+  int raised = 0;                                         ///< levels finer than asked (run_drawn's `raised`)
 };
 
 /// mesh3d_in_axes on `s` with its root cube shifted by lattice_draw_shift(k), within `limit`
 /// octants (0: the work bound of the run's first tree), ranked on `s` as meshed. Draws and
-/// retries (`retry`) make no mesh after a refusal (mesh3d_in_axes' `draw`).
+/// retries (`retry`) make no mesh after a refusal (mesh3d_in_axes' `draw`). `raised`: `opt` is
+/// that many levels finer than the level asked (Result3d::level_raised).
 Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t limit, std::string limit_origin,
-                const Progress3& progress, bool retry = false) {
+                const Progress3& progress, bool retry = false, int raised = 0) {
   Drawn d;
   d.draw = k;
+  d.raised = raised;
   d.effort.limit = limit;
   d.effort.limit_origin = std::move(limit_origin);
   const P3 shift0 = s.root_shift();
@@ -412,6 +416,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
   if (k > 0) o.raise_levels = 0;  // a level raise is degraded anyway
   try {
     Result3d r = mesh3d_in_axes(s, o, d.effort, k > 0 || retry, progress);
+    r.level_raised += raised;
     // Timed as stages of their own (report.json timings_s), not left in what the CLI counts
     // as the time of the tries not kept.
     StageTimer clock{r.times};
@@ -511,6 +516,15 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
   // voxel unions of the survey (seeds 4 and 5, level 3) were refused in their frame and none in
   // their given axes (session 33, one lattice).
   const int draws = turn ? std::min(opt.lattice_draws, 1) : opt.lattice_draws;
+  // A refusal at the level asked, with lattice draws to come: the draws at that level first,
+  // and one level finer (Options3d::raise_levels) only when none of them stands undegraded; the
+  // best of all the runs then stands, as before. The raise, made first, cost the most where a
+  // draw then stood anyway (a raised mesh is degraded): fandisk scaled by 10^4 (or 10^-4),
+  // level 4, refused there on its first lattice, spent 20 of its 32.6 s (34.1 s) one level
+  // finer before the first draw stood at level 4. The first run now goes on at its level
+  // after the refusal (the thickness and coarse tries, mesh3d_in_axes) instead.
+  // (In the frame of the planar faces the given axes' run comes last and raises as before.)
+  const bool raise_after_draws = !turn && draws > 0 && opt.raise_levels > 0;
   std::vector<Plan> plan{{turn, 0}};
   for (int k = 1; k <= draws; ++k) plan.push_back({turn, k});
   if (turn) plan.push_back({false, 0});
@@ -584,19 +598,41 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
       else
         progress("in the frame of the planar faces: " + what + "; once more in the given axes");
     }
-    runs.push_back(run_drawn(surface_of(p.in_frame), options_of(p.in_frame), p.draw, limit, origin, progress));
+    Options3d o = options_of(p.in_frame);
+    if (raise_after_draws && p.draw == 0) o.raise_levels = 0;
+    runs.push_back(run_drawn(surface_of(p.in_frame), o, p.draw, limit, origin, progress));
     Drawn& d = runs.back();
     settle(d, p.in_frame);
     // Of the runs so far: the lowest rank, then the least volume lost, then the first.
     if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
     if (d.rank == 0) break;
   }
+  const int n_runs = static_cast<int>(runs.size());  // the lattice's runs (Result3d::lattice_draws_run)
+  if (raise_after_draws && runs[best].rank >= 1 && runs[0].effort.refused_cheaply) {
+    // The raise mesh3d_raised makes: its tries one level finer within min_effort_octants.
+    Options3d finer = opt;
+    ++finer.level;
+    --finer.raise_levels;
+    finer.thickness_probe = false;  // the tries at the finer level as they were
+    finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);  // refused early, not after a huge tree
+    if (progress)
+      progress("no run at level " + std::to_string(opt.level) + " stands undegraded (" + std::to_string(n_runs) +
+               " run(s), the first refused there): once more at level " + std::to_string(finer.level));
+    runs.push_back(run_drawn(s, finer, 0, opt.min_effort_octants, "the bound of a level raise (min_effort_octants)",
+                             progress, true, 1));
+    Drawn& d = runs.back();
+    settle(d, false);
+    if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
+  }
   Drawn& b = runs[best];
   if (!b.r) {
     // Every run refused: the first run's refusal (the same type), with the others' reasons.
     std::string reasons = runs[0].why;
     for (std::size_t i = 1; i < runs.size(); ++i)
-      reasons += std::string("; ") + (runs[i].draw > 0 ? "lattice draw " + std::to_string(runs[i].draw) : "in the given axes") +
+      reasons += std::string("; ") +
+                 (runs[i].raised > 0  ? "at level " + std::to_string(opt.level + runs[i].raised)
+                  : runs[i].draw > 0 ? "lattice draw " + std::to_string(runs[i].draw)
+                                     : std::string("in the given axes")) +
                  ": " + runs[i].why;
     if (turn) reasons = "in the frame of the planar faces: " + reasons;
     if (runs[0].limit_error) throw LimitError(reasons);
@@ -608,7 +644,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
              (how == lost ? how : how + ", " + lost) + ")");
   }
   // The runs made after the first, whichever stands (a run's own index when it was made).
-  b.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
+  b.r->lattice_draws_run = n_runs - 1;
   if (!(b.rank <= 1 && b.min_deg < opt.flat_retry_below_deg && opt.flat_buffer < opt.flat_retry_buffer))
     return std::move(*b.r);
 
@@ -641,7 +677,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
                             ", " + volume_lost(retry.error) + "; " + (better ? "it stands" : "the mesh before it stands"));
   }
   Drawn& kept = better ? retry : b;
-  kept.r->lattice_draws_run = static_cast<int>(runs.size()) - 1;
+  kept.r->lattice_draws_run = n_runs - 1;
   kept.r->flat_retry_made = true;
   kept.r->flat_retry = better;
   return std::move(*kept.r);

@@ -59,11 +59,13 @@ struct Outcome3 {
 double det3(const P3& a, const P3& b, const P3& c) { return a.dot(b.cross(c)); }
 
 /// Meshes `surface` (validated and oriented here, as the CLI does) at `level` and measures it;
-/// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off).
+/// with `given_axes`, in the surface's own axes (Options3d::align_planar_faces off). `said`
+/// collects the progress messages.
 Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int lattice_draws = Options3d{}.lattice_draws,
                      double draw_below = Options3d{}.draw_min_dihedral_deg,
                      double draw_lost = Options3d{}.draw_max_volume_error,
-                     double flat_retry_below = Options3d{}.flat_retry_below_deg, double size_share = 0.0) {
+                     double flat_retry_below = Options3d{}.flat_retry_below_deg, double size_share = 0.0,
+                     std::vector<std::string>* said = nullptr) {
   validate_surface(surface, "generated");
   SurfaceBoundary s(std::move(surface));
   Options3d opt;
@@ -75,7 +77,10 @@ Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int la
   opt.draw_min_dihedral_deg = draw_below;
   opt.draw_max_volume_error = draw_lost;
   opt.flat_retry_below_deg = flat_retry_below;
-  Outcome3 out{mesh3d(s, opt), {}};
+  const Progress3 progress = [said](const std::string& m) {
+    if (said) said->push_back(m);
+  };
+  Outcome3 out{mesh3d(s, opt, progress), {}};
   const Mesh<3>& m = out.r.fe.mesh;
   const Box<3> bb = s.bounding_box();
   out.tolerance = 1e-10 * bb.extent().norm();
@@ -525,15 +530,38 @@ TEST_CASE("a cheap refusal at a coarse level is meshed one level finer", "[pipel
   CHECK(out.v.valid);
   CHECK(out.r.level_raised == 1);
   CHECK(out.r.lattice_draws_run == 0);
-  // With the lattice draws (Options3d::lattice_draws) the raised mesh is degraded: the lattice
-  // is shifted, and a draw at level 3 stands.
-  const Outcome3 drawn = run_surface(surface, 3, true);
+  // With the lattice draws (Options3d::lattice_draws) the draws at level 3 come first, and the
+  // raise only when none of them stands undegraded (a raised mesh is degraded): the second
+  // draw stands, and no tree of level 4 is built (it was, before the draws, until session 42).
+  const auto said_at = [](const std::vector<std::string>& said, const std::string& what) {
+    return std::find_if(said.begin(), said.end(), [&](const std::string& m) { return m.find(what) != std::string::npos; }) -
+           said.begin();
+  };
+  const std::string finer = "once more at level 4";
+  std::vector<std::string> said;
+  const Outcome3 drawn = run_surface(surface, 3, true, Options3d{}.lattice_draws, Options3d{}.draw_min_dihedral_deg,
+                                     Options3d{}.draw_max_volume_error, Options3d{}.flat_retry_below_deg, 0.0, &said);
   INFO(drawn.v.summary());
   CHECK(drawn.v.valid);
   CHECK(drawn.r.level_raised == 0);
   CHECK(drawn.r.lattice_draw > 0);
   CHECK(drawn.r.lattice_draws_run == drawn.r.lattice_draw);
   CHECK(summarize_quality<3>(drawn.r.fe.mesh).min_angle_deg >= Options3d{}.draw_min_dihedral_deg);
+  CHECK(said_at(said, finer) == static_cast<std::ptrdiff_t>(said.size()));
+  // One draw only: it is degraded too (a part left out), so the raise comes after it, and of the
+  // three runs the raised one, which loses the least, stands.
+  said.clear();
+  const Outcome3 one_draw = run_surface(surface, 3, true, 1, Options3d{}.draw_min_dihedral_deg,
+                                        Options3d{}.draw_max_volume_error, Options3d{}.flat_retry_below_deg, 0.0, &said);
+  INFO(one_draw.v.summary());
+  CHECK(one_draw.v.valid);
+  CHECK(one_draw.r.level_raised == 1);
+  CHECK(one_draw.r.lattice_draw == 0);
+  CHECK(one_draw.r.lattice_draws_run == 1);
+  const auto shifted = said_at(said, "with the lattice shifted");
+  CHECK(shifted < static_cast<std::ptrdiff_t>(said.size()));
+  CHECK(shifted < said_at(said, finer));
+  CHECK(said_at(said, finer) < static_cast<std::ptrdiff_t>(said.size()));
 }
 
 TEST_CASE("shrunk 3D property counterexamples not fixed yet", "[pipeline3d][regression][!mayfail]") {
