@@ -555,6 +555,11 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
   };
   std::vector<Drawn> runs;
   std::size_t best = 0;
+  // Of the runs so far: the lowest rank, then the least volume lost, then the first.
+  const auto rank_last = [&] {
+    const Drawn& d = runs.back();
+    if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
+  };
   for (std::size_t i = 0; i < plan.size(); ++i) {
     const Plan& p = plan[i];
     std::size_t limit = 0;
@@ -601,11 +606,9 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     Options3d o = options_of(p.in_frame);
     if (raise_after_draws && p.draw == 0) o.raise_levels = 0;
     runs.push_back(run_drawn(surface_of(p.in_frame), o, p.draw, limit, origin, progress));
-    Drawn& d = runs.back();
-    settle(d, p.in_frame);
-    // Of the runs so far: the lowest rank, then the least volume lost, then the first.
-    if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
-    if (d.rank == 0) break;
+    settle(runs.back(), p.in_frame);
+    rank_last();
+    if (runs.back().rank == 0) break;
   }
   const int n_runs = static_cast<int>(runs.size());  // the lattice's runs (Result3d::lattice_draws_run)
   if (raise_after_draws && runs[best].rank >= 1 && runs[0].effort.refused_cheaply) {
@@ -620,9 +623,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
                " run(s), the first refused there): once more at level " + std::to_string(finer.level));
     runs.push_back(run_drawn(s, finer, 0, opt.min_effort_octants, "the bound of a level raise (min_effort_octants)",
                              progress, true, 1));
-    Drawn& d = runs.back();
-    settle(d, false);
-    if (d.rank < runs[best].rank || (d.rank == runs[best].rank && d.error < runs[best].error)) best = runs.size() - 1;
+    settle(runs.back(), false);
+    rank_last();
   }
   Drawn& b = runs[best];
   if (!b.r) {
