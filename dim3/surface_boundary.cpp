@@ -23,9 +23,14 @@ bool is_vertex(TriangleRegion r) { return r >= TriangleRegion::Vertex0; }
 }  // namespace
 
 SurfaceBoundary::SurfaceBoundary(Surface surface, SurfaceOptions options)
+    : SurfaceBoundary(std::move(surface), AabbTree(), options) {}
+
+SurfaceBoundary::SurfaceBoundary(Surface surface, AabbTree tree, SurfaceOptions options)
     : surface_(std::move(surface)),
       options_(options),
-      tree_(surface_.vertices(), surface_.triangles()),
+      tree_(tree.n_triangles() == surface_.n_triangles() && surface_.n_triangles() > 0
+                ? std::move(tree)
+                : AabbTree(surface_.vertices(), surface_.triangles())),
       features_(surface_, options.features) {
   diagonal_ = surface_.bounding_box().extent().norm();
   const int nt = surface_.n_triangles();
@@ -185,8 +190,8 @@ double SurfaceBoundary::thickness(std::int32_t t) const {
 
 SurfaceBoundary SurfaceBoundary::from_file(const std::string& path, SurfaceOptions options) {
   Surface s(read_surface(path));
-  validate_surface(s, path);
-  return SurfaceBoundary(std::move(s), options);
+  AabbTree tree = validate_surface(s, path);
+  return SurfaceBoundary(std::move(s), std::move(tree), options);
 }
 
 Box<3> SurfaceBoundary::root_box() const {

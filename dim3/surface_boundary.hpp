@@ -65,6 +65,8 @@ class SurfaceBoundary final : public Boundary<3> {
  public:
   /// Requires a surface that passed validate_surface() (closed, manifold, oriented outward).
   explicit SurfaceBoundary(Surface surface, SurfaceOptions options = {});
+  /// The same with the surface's tree already built (validate_surface returns it).
+  SurfaceBoundary(Surface surface, AabbTree tree, SurfaceOptions options = {});
   /// Reads, validates and orients `path`; throws InputError naming it.
   static SurfaceBoundary from_file(const std::string& path, SurfaceOptions options = {});
 

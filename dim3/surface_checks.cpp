@@ -4,6 +4,7 @@
 #include <cmath>
 #include <iomanip>
 #include <numeric>
+#include <optional>
 #include <queue>
 #include <sstream>
 
@@ -169,7 +170,7 @@ std::vector<int> nesting_depths(const Surface& s, const AabbTree& tree) {
   return depth;
 }
 
-int orient_outward(Surface& s, const std::string& name) {
+int orient_outward(Surface& s, const std::string& name, AabbTree* tree) {
   const int nt = s.n_triangles();
   std::vector<bool> flip(nt, false), seen(nt, false);
   // Breadth-first over manifold edges: each neighbour must run the shared edge the other way.
@@ -200,8 +201,9 @@ int orient_outward(Surface& s, const std::string& name) {
   int n_flipped = static_cast<int>(std::count(flip.begin(), flip.end(), true));
   if (n_flipped > 0) s.flip(flip);
 
-  const AabbTree tree(s.vertices(), s.triangles());
-  const std::vector<int> depth = nesting_depths(s, tree);
+  std::optional<AabbTree> own;
+  if (!tree || n_flipped > 0) own.emplace(s.vertices(), s.triangles());
+  const std::vector<int> depth = nesting_depths(s, own ? *own : *tree);
   std::vector<bool> flip_component(s.n_components(), false);
   bool any = false;
   for (int c = 0; c < s.n_components(); ++c) {
@@ -215,10 +217,11 @@ int orient_outward(Surface& s, const std::string& name) {
     n_flipped += static_cast<int>(std::count(which.begin(), which.end(), true));
     s.flip(which);
   }
+  if (tree && n_flipped > 0) *tree = AabbTree(s.vertices(), s.triangles());
   return n_flipped;
 }
 
-void validate_surface(Surface& s, const std::string& name) {
+AabbTree validate_surface(Surface& s, const std::string& name) {
   if (s.n_triangles() == 0) throw InputError(name + ": empty surface (no triangles)");
   if (const auto bad = non_manifold_edges(s); !bad.empty())
     throw InputError(name + ": non-manifold: " + std::to_string(bad.size()) +
@@ -233,12 +236,13 @@ void validate_surface(Surface& s, const std::string& name) {
   if (const auto bad = degenerate_triangles(s); !bad.empty())
     throw InputError(name + ": " + std::to_string(bad.size()) + " degenerate (zero-area) triangle(s), e.g. " +
                      fmt_triangle(s, bad[0]));
-  const AabbTree tree(s.vertices(), s.triangles());
+  AabbTree tree(s.vertices(), s.triangles());
   if (const auto bad = self_intersections(s, tree); !bad.empty())
     throw InputError(name + ": self-intersecting: " + std::to_string(bad.size()) +
                      " pair(s) of triangles intersect, e.g. " + fmt_triangle(s, bad[0].first) + " and " +
                      fmt_triangle(s, bad[0].second));
-  orient_outward(s, name);
+  orient_outward(s, name, &tree);
+  return tree;
 }
 
 }  // namespace febemesh::dim3

@@ -38,10 +38,16 @@ std::vector<int> nesting_depths(const Surface& s, const AabbTree& tree);
 /// Makes each component consistently oriented, then flips whole components so that the signed
 /// volume of each is positive at even nesting depth and negative at odd depth (cavities),
 /// i.e. every normal points out of the solid. Returns the number of triangles flipped.
-/// Throws InputError if a component is not orientable.
-int orient_outward(Surface& s, const std::string& name);
+/// Throws InputError if a component is not orientable. `tree`, when given, is the tree of `s`
+/// as it comes and is left the tree of `s` as it goes: the same object where nothing flipped,
+/// else built again (a flip changes the order of a triangle's corners, so its centroid's
+/// rounding and the tree may change: rebuilt, it is the tree a fresh build would make).
+int orient_outward(Surface& s, const std::string& name, AabbTree* tree = nullptr);
 
-/// Every check above, then orient_outward. Throws InputError "<name>: <reason>".
-void validate_surface(Surface& s, const std::string& name);
+/// Every check above, then orient_outward. Throws InputError "<name>: <reason>". Returns the
+/// tree of the surface as oriented, the one SurfaceBoundary would build: built once here where
+/// nothing flips (three builds before: the self-intersection test, the nesting depths and
+/// SurfaceBoundary; 0.14 s each at 473,088 triangles).
+AabbTree validate_surface(Surface& s, const std::string& name);
 
 }  // namespace febemesh::dim3

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "dim3/read_surface.hpp"
 #include "dim3/surface.hpp"
+#include "dim3/surface_boundary.hpp"
 #include "dim3/surface_checks.hpp"
 
 using namespace febemesh;
@@ -123,6 +124,34 @@ TEST_CASE("an inverted sphere is accepted and turned outward", "[read_surface]")
   validate_surface(s, flipped.string());
   CHECK(s.volume() == Approx(v0).epsilon(1e-12));
   CHECK(is_consistently_oriented(s));
+}
+
+TEST_CASE("validate_surface returns the tree of the surface as oriented", "[read_surface]") {
+  // The tree a fresh build of the oriented surface makes, corner for corner, whether the
+  // surface came oriented (the tree of the self-intersection test, kept) or not (built again
+  // after the flips); SurfaceBoundary takes it instead of building its own.
+  Surface original(read_surface(data3d + "sphere966.off"));
+  Surface inverted = original;
+  std::vector<bool> all(static_cast<std::size_t>(inverted.n_triangles()), true);
+  inverted.flip(all);
+  for (Surface* s : {&original, &inverted}) {
+    const AabbTree tree = validate_surface(*s, "sphere966.off");
+    const AabbTree fresh(s->vertices(), s->triangles());
+    REQUIRE(tree.n_triangles() == fresh.n_triangles());
+    CHECK(tree.n_nodes() == fresh.n_nodes());
+    std::size_t differ = 0;
+    for (std::int32_t t = 0; t < s->n_triangles(); ++t) {
+      const Triangle& tr = s->triangle(t);
+      for (int k = 0; k < 3; ++k)
+        differ += tree.points(t)[k] != fresh.points(t)[k] || tree.points(t)[k] != s->vertex(tr[k]) ? 1 : 0;
+    }
+    CHECK(differ == 0);
+    CHECK(tree.bounds().lo == fresh.bounds().lo);
+    CHECK(tree.bounds().hi == fresh.bounds().hi);
+    const SurfaceBoundary b(*s, validate_surface(*s, "again"));
+    const P3 probe = s->bounding_box().center() + P3(0.31, -0.17, 0.05);
+    CHECK(b.closest_point(probe).point == SurfaceBoundary(*s).closest_point(probe).point);
+  }
 }
 
 TEST_CASE("a sphere with a cavity: the inner shell is oriented inward", "[read_surface]") {
