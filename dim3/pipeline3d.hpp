@@ -230,7 +230,9 @@ struct Options3d {
   std::size_t min_effort_octants = 2000000;
   /// When every try is refused after building on fewer than min_effort_octants octants (a
   /// coarse level for the shape), mesh3d tries up to this many levels finer, each within
-  /// min_effort_octants octants (Result3d::level_raised). 0: refuse instead.
+  /// min_effort_octants octants (Result3d::level_raised). 0: refuse instead. With lattice draws
+  /// in the given axes the raise comes after them, and only when no run at the level asked
+  /// stands undegraded (a raised mesh is degraded).
   int raise_levels = 1;
   /// Mesh in the frame of the surface's planar faces when it puts 10% more of the area on
   /// planes square to an axis than the given axes do (dim3/planar_frame.hpp), and turn the mesh
@@ -361,7 +363,8 @@ using Progress3 = std::function<void(const std::string&)>;
 /// (Result3d::buffer_fallback). Without buffer_last: with the buffer rule; without it
 /// (Result3d::buffer_dropped); with facing projections. All of them with feature snapping first,
 /// then all without (Options3d::features_fallback_last, Result3d::features_dropped); when those
-/// are refused cheaply, all of it one level finer (Options3d::raise_levels).
+/// are refused cheaply, all of it one level finer (Options3d::raise_levels; after the lattice
+/// draws, Options3d::lattice_draws).
 Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt, const Progress3& progress = {});
 
 /// The optimisation's aim (the CLI's --target-dihedral): the node sweeps' target_dihedral_deg and
