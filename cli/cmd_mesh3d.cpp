@@ -153,7 +153,8 @@ const char* help_text =
     "Bad input (open, non-manifold or self-intersecting surface, unreadable file) exits with\n"
     "status 1 and writes nothing; so does a surface whose boundary octants cannot be built\n"
     "up to the maximum level or within the work bound. A coarse level refused cheaply (under\n"
-    "2*10^6 octants) is tried once more one level finer, with a warning.\n";
+    "2*10^6 octants) is tried once more one level finer, with a warning: after the lattice\n"
+    "draws, when none of them stands undegraded.\n";
 
 nlohmann::json quality_json(const QualitySummary& q) {
   nlohmann::json j;
