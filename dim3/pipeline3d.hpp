@@ -231,8 +231,9 @@ struct Options3d {
   /// When every try is refused after building on fewer than min_effort_octants octants (a
   /// coarse level for the shape), mesh3d tries up to this many levels finer, each within
   /// min_effort_octants octants (Result3d::level_raised). 0: refuse instead. With lattice draws
-  /// in the given axes the raise comes after them, and only when no run at the level asked
-  /// stands undegraded (a raised mesh is degraded).
+  /// the first run's raise comes after them (in the frame of the planar faces, after the
+  /// frame's draw and the given axes' run), and only when no run at the level asked stands
+  /// undegraded (a raised mesh is degraded).
   int raise_levels = 1;
   /// Mesh in the frame of the surface's planar faces when it puts 10% more of the area on
   /// planes square to an axis than the given axes do (dim3/planar_frame.hpp), and turn the mesh
