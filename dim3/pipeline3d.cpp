@@ -194,6 +194,18 @@ std::string volume_lost(double error) {
   return text;
 }
 
+/// A level raise's options (Options3d::raise_levels): one level finer, one raise fewer, the tries
+/// at the finer level as they were (no thickness probe), refused early rather than after a huge
+/// tree (at most min_effort_octants octants).
+Options3d one_level_finer(const Options3d& opt) {
+  Options3d finer = opt;
+  finer.thickness_probe = false;
+  ++finer.level;
+  --finer.raise_levels;
+  finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);
+  return finer;
+}
+
 /// mesh3d_tries, and when every try is refused although they built on fewer octants than
 /// opt.min_effort_octants (a coarse level: the features are a couple of octants across), once
 /// more one level finer within that many octants (Result3d::level_raised). Measured: the 4x4x4
@@ -207,11 +219,7 @@ Result3d mesh3d_raised(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
     if (opt.raise_levels <= 0 || !effort.refused_cheaply) throw;
     if (progress) progress("refused at level " + std::to_string(opt.level) + " (" + e.what() + "): once more at level " +
                            std::to_string(opt.level + 1));
-    Options3d finer = opt;
-    finer.thickness_probe = false;  // the tries at the finer level as they were
-    ++finer.level;
-    --finer.raise_levels;
-    finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);  // refused early, not after a huge tree
+    const Options3d finer = one_level_finer(opt);
     Effort raised;
     raised.limit = opt.min_effort_octants;
     const auto both = [&](const std::exception& finer_error) {
@@ -618,11 +626,7 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     // The raise mesh3d_raised makes, in the first run's axes: its tries one level finer within
     // min_effort_octants.
     const bool in_frame = plan[0].in_frame;
-    Options3d finer = options_of(in_frame);
-    ++finer.level;
-    --finer.raise_levels;
-    finer.thickness_probe = false;  // the tries at the finer level as they were
-    finer.max_cells = std::min(finer.max_cells, finer.min_effort_octants);  // refused early, not after a huge tree
+    const Options3d finer = one_level_finer(options_of(in_frame));
     if (progress)
       progress("no run at level " + std::to_string(finer.level - 1) + " stands undegraded (" + std::to_string(n_runs) +
                " run(s), the first refused there): once more at level " + std::to_string(finer.level) +

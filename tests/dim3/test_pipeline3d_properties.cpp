@@ -66,8 +66,8 @@ Outcome3 run_surface(Surface surface, int level, bool given_axes = false, int la
                      double draw_lost = Options3d{}.draw_max_volume_error,
                      double flat_retry_below = Options3d{}.flat_retry_below_deg, double size_share = 0.0,
                      std::vector<std::string>* said = nullptr) {
-  validate_surface(surface, "generated");
-  SurfaceBoundary s(std::move(surface));
+  AabbTree tree = validate_surface(surface, "generated");
+  SurfaceBoundary s(std::move(surface), std::move(tree));
   Options3d opt;
   opt.level = level;
   // --size: this share of the default cube's octant at `level` (Options3d::size).
