@@ -865,6 +865,7 @@ template <int Dim> ValidationReport validate(const Mesh<Dim>& mesh, const Valida
       problems.add("the Euler characteristic differs", -1, [&](auto& os) { os << "Euler characteristic " << r.euler << ", expected " << *options.expected_euler; });
   }
 
+  if (mesh.solid.size() == 0) problems.add("the mesh is empty", -1, [&](auto& os) { os << "no solid elements"; });
   r.valid = r.conforms() && r.off_boundary_nodes == 0 && (!options.expected_euler || *options.expected_euler == r.euler);
   return r;
 }

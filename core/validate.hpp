@@ -82,9 +82,11 @@ struct ValidationReport {
   /// One line per nonzero count, then the problems.
   std::string summary() const;
   /// Valid but for the surface's checks (the interface nodes' distance, the Euler
-  /// characteristic): what `valid` is without those options.
+  /// characteristic): what `valid` is without those options. A mesh without solid elements is
+  /// not valid: it meshes nothing, and the other checks pass on it (its Euler characteristic 0
+  /// is a torus's: a pipeline that lost a whole thin torus passed, session 43).
   bool conforms() const {
-    return bad_elements == 0 && inverted == 0 && nonconforming_facets == 0 && hanging_nodes == 0 &&
+    return n_solid > 0 && bad_elements == 0 && inverted == 0 && nonconforming_facets == 0 && hanging_nodes == 0 &&
            interface_mismatch == 0 && unused_nodes == 0 && duplicate_nodes == 0 && attribute_mismatch == 0;
   }
 };

@@ -1,10 +1,12 @@
 #include "dim3/mesh3d_try.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -367,7 +369,9 @@ struct RepairLoop {
   /// one); `euler`: the mesh's Euler characteristic, when looked at. True when the tree was
   /// refined.
   bool refine_surface_octants(TreeMesh& tm, bool smoothed, std::optional<long> euler) {
-    const bool topology_wrong = euler && s.euler_characteristic() % 2 == 0 && *euler != s.euler_characteristic() / 2;
+    const bool empty = tm.fe.mesh.solid.empty();
+    const bool topology_wrong =
+        empty || (euler && s.euler_characteristic() % 2 == 0 && *euler != s.euler_characteristic() / 2);
     // Not for islands alone where the island trial showed that one level more does not
     // resolve them: refining every octant on the surface is that refinement and more (rotor
     // L5: 14125 octants refined, then 678 -> 338 -> 736 -> 439 problems over the repairs, the
@@ -383,9 +387,10 @@ struct RepairLoop {
     ++r.n_repairs;
     say("repair " + std::to_string(attempt + 1) + ": refining the " + std::to_string(n_marked) +
         " octants on the surface (" +
-        (topology_wrong ? "Euler characteristic " + std::to_string(*euler) + ", expected " +
-                              std::to_string(s.euler_characteristic() / 2)
-                        : std::to_string(r.n_islands_dropped) + " octants in islands") +
+        (empty            ? std::string("no interior octant: the solid is thinner than the octants everywhere")
+         : topology_wrong ? "Euler characteristic " + std::to_string(*euler) + ", expected " +
+                                std::to_string(s.euler_characteristic() / 2)
+                          : std::to_string(r.n_islands_dropped) + " octants in islands") +
         ")");
     saved = Saved{r, tree, tm.in, tm.oc, std::move(tm.fe), !topology_wrong, smoothed};
     n_prev_problems = std::numeric_limits<std::size_t>::max();  // a fresh start for the repairs
@@ -524,7 +529,10 @@ struct RepairLoop {
       return validate(m, vo);
     };
     const long euler = euler_characteristic<3>(tm.fe.mesh, opt.n_threads);
-    tm.topology_right = s.euler_characteristic() % 2 != 0 || euler == s.euler_characteristic() / 2;
+    // A tree without an interior octant meshes nothing, whose Euler characteristic 0 is a
+    // torus's: wrong too (a thin torus at 1.75 level-3 octants, session 43, stood empty).
+    tm.topology_right = !tm.fe.mesh.solid.empty() &&
+                        (s.euler_characteristic() % 2 != 0 || euler == s.euler_characteristic() / 2);
     return !tm.topology_right && (!tm.before_escobar || validation(tm.fe.mesh).valid) &&
            refine_surface_octants(tm, false, euler);
   }
@@ -807,7 +815,16 @@ struct RepairLoop {
 
 Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   RepairLoop loop(s, opt, effort, progress);
-  return loop.run();
+  Result3d r = loop.run();
+  // No try stands on an empty mesh (the validator refuses it too): the fallbacks, the lattice
+  // draws and the level raise take it as the refusal it is.
+  if (r.fe.mesh.solid.empty()) {
+    std::ostringstream why;
+    why << "no interior octant: every part of the solid is thinner than the octants ("
+        << s.root_box().extent().maxCoeff() / std::exp2(opt.level) << " across; a finer --level or --size meshes it)";
+    throw GeometryError(why.str());
+  }
+  return r;
 }
 
 }  // namespace febemesh::dim3

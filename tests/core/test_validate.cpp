@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <string>
 
 #include "core/mesh_topology.hpp"
 #include "core/quality.hpp"
@@ -12,6 +13,27 @@
 #include "test_mesh_fixtures.hpp"
 
 using namespace febemesh;
+
+// A mesh without solid elements meshes nothing, and every other check passes on it: no element
+// to invert or to leave a facet open, Euler characteristic 0. With an expected 0 (a torus, an
+// annulus) it was valid: a 3D run that lost a whole thin torus stood empty (session 43, seed 1159).
+TEMPLATE_TEST_CASE_SIG("an empty mesh is not valid", "[validate]", ((int Dim), Dim), 2, 3) {
+  Mesh<Dim> empty;
+  ValidateOptions<Dim> opt;
+  opt.expected_euler = 0;
+  opt.boundary_distance = [](const Point<Dim>&) { return 0.0; };
+  const ValidationReport r = validate(empty, opt);
+  INFO(r.summary());
+  CHECK(r.euler == 0);
+  CHECK_FALSE(r.conforms());
+  CHECK_FALSE(r.valid);
+  CHECK(r.n_problems == 1);
+  CHECK(r.summary().find("no solid elements") != std::string::npos);
+  CHECK_FALSE(is_valid(empty));
+  // One element is enough to be a mesh of something.
+  const Mesh<Dim> one = test::grid_mesh<Dim>(1, true);
+  CHECK(is_valid(one));
+}
 
 TEMPLATE_TEST_CASE_SIG("structured grids are valid", "[validate]", ((int Dim), Dim), 2, 3) {
   for (const bool simplices : {false, true}) {

@@ -86,6 +86,43 @@ TEST_CASE("mesh3d refuses an open surface with exit 1 and writes nothing", "[pip
   std::filesystem::remove(out.string() + ".err");
 }
 
+// A torus whose tube (0.7 across) is 1.1 octants thick at --size 1.745 level-3 octants
+// (test_dim3 "[property]" seed 1159): no octant lies inside it, so every try built an empty mesh,
+// whose Euler characteristic 0 is the torus's, and the run stood on it, "valid", with 0
+// tetrahedra. Now an empty mesh has the wrong topology (the octants on the surface are refined,
+// as for a sphere that falls apart) and no try stands on one.
+TEST_CASE("mesh3d: a torus thinner than the octants is meshed, not left empty", "[pipeline3d]") {
+  SurfaceBoundary s =
+      SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-seed1159-size-empty.off");
+  Options3d opt;
+  opt.level = 3;
+  opt.size = 1.745 * s.root_box().extent()[0] / 8.0;
+  const Result3d r = mesh3d(s, opt);
+  REQUIRE(r.fe.mesh.solid.size() > 0);
+  const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+  INFO(v.summary());
+  CHECK(v.valid);
+  CHECK(r.fe.mesh.interface.size() > 0);
+  CHECK(r.level_raised == 0);
+  // The first tree has no interior octant: a run on it alone (no topology refinement, no
+  // thin-part retry, no draws) is refused, naming it.
+  Options3d bare = opt;
+  bare.topology_refinements = 0;
+  bare.thin_retry_cells = 0.0;
+  bare.lattice_draws = 0;
+  bare.raise_levels = 0;
+  bare.coarse_thin_after_refusal = false;
+  bare.refused_thickness_cells = 0.0;
+  bare.align_planar_faces = false;
+  std::string what;
+  try {
+    mesh3d(s, bare);
+  } catch (const GeometryError& e) {
+    what = e.what();
+  }
+  CHECK(what.find("no interior octant") != std::string::npos);
+}
+
 // The work bound (Options3d::effort): the coarse perturbed sphere of the regressions, with
 // feature snapping forced, needs 3 repairs, then meshes without it (3088 + 5461 + 8856 + 11775
 // + 3088 = 32268 octants built on, measured). A bound of twice the first tree (6176) stops it
