@@ -249,10 +249,10 @@ TEST_CASE("hex-dominant: cells changed by edge removal stay tetrahedra (thin tor
 }
 
 // The hex run ranks its own mesh: a hex-dominant mesh's volume is not its tetrahedra's (warped
-// quads), so where the tet mesh loses a little under Options3d::draw_lost_pct the hex mesh can
-// lose more than it and take a lattice draw the tet run does not (the property below found this
-// torus, seed 1073: 10.83% lost on the first lattice, 6.05% on draw 1). The merges' angle bound
-// holds against the tetrahedra merged, those of the draw.
+// quads), so where the tet mesh loses a little under Options3d::draw_max_volume_error the hex
+// mesh can lose more than it and take a lattice draw the tet run does not (the property below
+// found this torus, seed 1073: 10.83% lost on the first lattice, 6.05% on draw 1). The merges'
+// angle bound holds against the tetrahedra merged, those of the draw.
 TEST_CASE("hex-dominant: a hex mesh losing more volume than its tets takes its own lattice draw", "[hex_dominant]") {
   SurfaceBoundary s =
       SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-seed1073-hex-draw.off");
@@ -412,10 +412,10 @@ TEST_CASE("hex-dominant meshes of tori and voxel unions are valid when the tet m
       // volume is not its tets' (warped quads), so the runs can keep different meshes
       // (shrunk voxel union, session 17: first meshes 7.45% / 6.99%, retries 7.46% / 6.81%:
       // the hex run kept its first mesh, the tet run its retry; 13.68 deg against 26.91), and
-      // the lattice draws follow the volume lost past Options3d::draw_lost_pct (a torus, seed
-      // 1073: the hex mesh lost 10.83%, the tets under 10%, so the hex run stood on draw 1,
-      // whose tetrahedra reach 13.38 deg, the tet run on its first lattice at 16.23;
-      // regressions/torus-seed1073-hex-draw.off below).
+      // the lattice draws follow the volume lost past Options3d::draw_max_volume_error (a
+      // torus, seed 1073: the hex mesh lost 10.83%, the tets under 10%, so the hex run stood
+      // on draw 1, whose tetrahedra reach 13.38 deg, the tet run on its first lattice at 16.23;
+      // regressions/torus-seed1073-hex-draw.off above).
       const double tet_min = summarize_quality<3>(tet.fe.mesh).min_angle_deg;
       const double hex_min = summarize_quality<3>(r.fe.mesh).min_angle_deg;
       RC_ASSERT(hex_min >= std::min(opt.hex.min_dihedral_deg, r.hex.tets_min_dihedral_deg) - 1e-9);
