@@ -61,6 +61,18 @@ TypeCounts count_types(const Mesh<3>& m) {
   return c;
 }
 
+/// The tet run at `level` without edge removal (its rounds differ between the kinds: 30 deg for
+/// tets, 15 for the merge, then 30 at the tetrahedra left under 15, and the optimiser's passes
+/// after them move surface nodes differently), and the hex run with the same options.
+std::pair<Result3d, Result3d> tet_and_hex_runs(SurfaceBoundary& s, int level) {
+  Options3d opt;
+  opt.level = level;
+  opt.remove_edges_below_deg = 0.0;
+  Result3d tet = mesh3d(s, opt);
+  opt.hex_dominant = true;
+  return {std::move(tet), mesh3d(s, opt)};
+}
+
 /// The two runs kept meshes made the same way (the retries and draws that decide which mesh
 /// stands), so the hex run merged the tet run's tetrahedra.
 bool same_path(const Result3d& a, const Result3d& b) {
@@ -159,15 +171,7 @@ TEST_CASE("hex-dominant meshes are the same twice", "[hex_dominant]") {
 
 TEST_CASE("the tet default makes no hexes; the hex mode keeps the tet mesh's surface nodes", "[hex_dominant]") {
   SurfaceBoundary s = SurfaceBoundary::from_file(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
-  Options3d opt;
-  opt.level = 3;
-  // Without edge removal: its rounds differ between the kinds (30 deg for tets, 15 for the merge,
-  // then 30 at the tetrahedra left under 15), and the optimiser's passes after them move surface
-  // nodes differently.
-  opt.remove_edges_below_deg = 0.0;
-  const Result3d tet = mesh3d(s, opt);
-  opt.hex_dominant = true;
-  const Result3d hex = mesh3d(s, opt);
+  const auto [tet, hex] = tet_and_hex_runs(s, 3);
   const TypeCounts c = count_types(tet.fe.mesh);
   CHECK(c.tet == tet.fe.mesh.solid.size());
   CHECK(c.triangles == tet.fe.mesh.interface.size());
@@ -256,12 +260,7 @@ TEST_CASE("hex-dominant: cells changed by edge removal stay tetrahedra (thin tor
 TEST_CASE("hex-dominant: a hex mesh losing more volume than its tets takes its own lattice draw", "[hex_dominant]") {
   SurfaceBoundary s =
       SurfaceBoundary::from_file(std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/torus-seed1073-hex-draw.off");
-  Options3d opt;
-  opt.level = 3;
-  opt.remove_edges_below_deg = 0.0;
-  const Result3d tet = mesh3d(s, opt);
-  opt.hex_dominant = true;
-  const Result3d r = mesh3d(s, opt);
+  const auto [tet, r] = tet_and_hex_runs(s, 3);
   CHECK(tet.lattice_draw == 0);
   CHECK(r.lattice_draw == 1);
   CHECK(!same_path(r, tet));
@@ -269,7 +268,7 @@ TEST_CASE("hex-dominant: a hex mesh losing more volume than its tets takes its o
   INFO(v.summary());
   CHECK(v.valid);
   const double hex_min = summarize_quality<3>(r.fe.mesh).min_angle_deg;
-  CHECK(hex_min >= std::min(opt.hex.min_dihedral_deg, r.hex.tets_min_dihedral_deg) - 1e-9);
+  CHECK(hex_min >= std::min(Options3d{}.hex.min_dihedral_deg, r.hex.tets_min_dihedral_deg) - 1e-9);
   CHECK(r.hex.tets_min_dihedral_deg < summarize_quality<3>(tet.fe.mesh).min_angle_deg);
 }
 
