@@ -649,7 +649,9 @@ void CurveBoundary::compute_automatic_levels() {
   }
 }
 
-double CurveBoundary::control_level(const Box<2>& box) const {
+double CurveBoundary::control_level(const Box<2>& box) const { return control_level(box, floor_boost_default); }
+
+double CurveBoundary::control_level(const Box<2>& box, double floor_boost) const {
   double lv = 0.0;
   const double global = global_level_ != no_level ? global_level_
                         : domain_.default_level != no_level ? domain_.default_level + file_level_shift_

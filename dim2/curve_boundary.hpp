@@ -61,6 +61,11 @@ class CurveBoundary final : public Boundary<2> {
   /// Open segment: touches within 1e-10 of the domain size of a or b are ignored.
   bool segment_crosses(const P2& a, const P2& b) const override;
   double control_level(const Box<2>& box) const override;
+  /// control_level with the thickness and curvature floors allowed up to `floor_boost` levels
+  /// beyond a given level instead of floor_boost_default (control_level's).
+  double control_level(const Box<2>& box, double floor_boost) const;
+  /// How far beyond a given level the floors go (the rule above).
+  static constexpr double floor_boost_default = 4.0;
 
   // --- 2D API -----------------------------------------------------------------------------
   const Domain& domain() const { return domain_; }
@@ -175,7 +180,6 @@ class CurveBoundary final : public Boundary<2> {
   /// [loop][piece]: the level the piece needs whatever was asked: cells no larger than a
   /// quarter of the feature thickness nor cells_per_radius x the smallest radius of curvature.
   std::vector<std::vector<double>> floor_level_;
-  static constexpr double floor_boost = 4.0;  ///< at most this far beyond a given level
   Box<2> bbox_;
   double scale_ = 1.0;  ///< largest extent of the bounding box
   double global_level_ = no_level;

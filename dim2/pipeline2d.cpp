@@ -50,9 +50,15 @@ std::vector<Problem> inverted_elements(const Mesh<2>& m, int n_threads) {
   return out;
 }
 
-}  // namespace
+/// The refusal of a run whose last problems include chains of free edges projecting onto two
+/// loops: parts thinner than the quadrants there (Options2d::thin_retry_boost).
+struct ThinPartsRefusal : GeometryError {
+  using GeometryError::GeometryError;
+};
 
-Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress& progress) {
+/// The pipeline with the level field's floors up to `floor_boost` levels beyond a given level
+/// (CurveBoundary::control_level).
+Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Progress& progress, double floor_boost) {
   auto say = [&](const std::string& s) {
     if (progress) progress(s);
   };
@@ -70,7 +76,7 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
   // curve quadrants, and so the mesh, are those of the uniform outside; the tree of a glyph
   // was three quarters outside leaves (NimbusSans U0067 at level 11: 16.8 M, 4.3 M inside).
   const ControlFn<2> control = [&](const Box<2>& b) {
-    return !opt.split_outside && curve.classify(b) == Side::Out ? 0.0 : curve.control_level(b);
+    return !opt.split_outside && curve.classify(b) == Side::Out ? 0.0 : curve.control_level(b, floor_boost);
   };
   Orthtree<2> tree = subdivide_by_control(curve.root_box(), control, ro);
   clock.lap("subdivide");
@@ -231,15 +237,47 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     Flags flags;
     std::vector<Point<2>> places;
     for (const Problem& pr : problems) places.push_back(pr.where);
-    if (last || !mark_around<2>(tree, places, 2.0, opt.max_level, flags))
-      throw GeometryError("the boundary quadrants cannot be built after " + std::to_string(r.n_repairs) +
-                          " local refinements (max level " + std::to_string(opt.max_level) + "): " + describe(problems));
+    if (last || !mark_around<2>(tree, places, 2.0, opt.max_level, flags)) {
+      const std::string why = "the boundary quadrants cannot be built after " + std::to_string(r.n_repairs) +
+                              " local refinements (max level " + std::to_string(opt.max_level) + "): " + describe(problems);
+      if (std::any_of(problems.begin(), problems.end(),
+                      [](const Problem& p) { return p.what.find("onto two loops") != std::string::npos; }))
+        throw ThinPartsRefusal(why);
+      throw GeometryError(why);
+    }
     ++r.n_repairs;
     r.repaired.insert(r.repaired.end(), problems.begin(), problems.end());
     say("repair " + std::to_string(attempt + 1) + ": refining around " + std::to_string(problems.size()) +
         " place(s): " + describe(problems));
     tree = balance_2to1(refine(tree, flags), BalanceKind::Face, balancing);
     clock.lap("repair refinement");
+  }
+}
+
+}  // namespace
+
+Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress& progress) {
+  try {
+    return mesh2d_once(curve, opt, progress, CurveBoundary::floor_boost_default);
+  } catch (const ThinPartsRefusal& e) {
+    // The floors stop floor_boost_default levels beyond a given level (--level, --size, the
+    // file's levels): a part thinner than 4 quadrants of that finest level is not resolved, and
+    // refining around its problems went on past the repairs allowed (an annulus 2 thick, 80
+    // across, at --size 10: refused after 12 repairs; at 9 meshed). Only after such a refusal,
+    // so that every mesh made before stays the same; automatic levels have no such stop.
+    if (curve.is_automatic() || !(opt.thin_retry_boost > CurveBoundary::floor_boost_default)) throw;
+    if (progress)
+      progress(std::string(e.what()) + "; once more with the thickness rule up to " +
+               std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked");
+    try {
+      Result2d r = mesh2d_once(curve, opt, progress, opt.thin_retry_boost);
+      r.thin_parts_refined = true;
+      return r;
+    } catch (const GeometryError& again) {
+      throw GeometryError(std::string(e.what()) + "; with the thickness rule up to " +
+                          std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked: " +
+                          again.what());
+    }
   }
 }
 

@@ -29,6 +29,11 @@ struct Options2d {
   int max_level = 16;                ///< no quadrant finer than this (repairs included)
   int max_repairs = 12;              ///< local refinements when the construction needs them
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError) instead of exhausting memory
+  /// With given levels the thickness and curvature floors go at most
+  /// CurveBoundary::floor_boost_default levels beyond them; when the run is refused with chains
+  /// projecting onto two loops (parts thinner than the quadrants), it is made once more with the
+  /// floors up to this many levels beyond (Result2d::thin_parts_refined). <= 4: never.
+  double thin_retry_boost = 8.0;
   /// Split boxes outside the solid to the level field too (they hold no element; off: they stay
   /// whole and the balance grades them, the same mesh from a smaller tree). For tests.
   bool split_outside = false;
@@ -58,6 +63,7 @@ struct Result2d {
   std::size_t n_buffer_dropped = 0;
   std::size_t n_pinches_dropped = 0;
   int n_repairs = 0;
+  bool thin_parts_refined = false;  ///< made by Options2d::thin_retry_boost's retry
   std::vector<Problem> repaired;    ///< what the repairs were for
   std::size_t n_smoothing_rejected = 0;
   std::size_t n_flips = 0;          ///< edge flips of the quality pass
@@ -67,8 +73,9 @@ struct Result2d {
 
 using Progress = std::function<void(const std::string&)>;
 
-/// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level and
-/// LimitError when the tree would exceed max_cells.
+/// Runs the whole pipeline; throws GeometryError when a repair would exceed max_level (after the
+/// thin-parts retry, Options2d::thin_retry_boost) and LimitError when the tree would exceed
+/// max_cells.
 Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress& progress = {});
 
 }  // namespace febemesh::dim2

@@ -54,6 +54,7 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   bq["buffer_dropped"] = r.n_buffer_dropped;
   bq["pinches_dropped"] = r.n_pinches_dropped;
   bq["repairs"] = r.n_repairs;
+  bq["thin_parts_refined"] = r.thin_parts_refined;  // Options2d::thin_retry_boost's retry made it
   bq["smoothing_moves_rejected"] = r.n_smoothing_rejected;
   j["boundary_quadrants"] = bq;
 

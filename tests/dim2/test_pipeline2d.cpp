@@ -9,12 +9,14 @@
 #include <vector>
 
 #include "core/quality.hpp"
+#include "core/error.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/fidelity2d.hpp"
 #include "dim2/pipeline2d.hpp"
 #include "dim2/read_domain.hpp"
+#include "dim2/read_svg.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim2;
@@ -179,6 +181,44 @@ TEST_CASE("a bend tighter than the quadrants is refined even with a given level"
   const Fidelity2d f = measure_fidelity(r.fe, curve);
   INFO("smallest radius " << r_min << ", Hausdorff " << f.hausdorff << " = " << f.hausdorff / r_min << " R");
   CHECK(f.hausdorff < 0.05 * r_min);
+}
+
+// An annulus 2 thick and 80 across at level 3: the thickness floor (quadrants a quarter of the
+// thickness) stops 4 levels beyond the level asked, where a quadrant is 0.82, and refining
+// around the chains that project onto both loops went past the 12 repairs: refused (before
+// session 43 for good). The retry lets the floor go 8 levels beyond: meshed, valid.
+TEST_CASE("a part thinner than the floors' finest quadrants is meshed by the thin-parts retry", "[pipeline2d]") {
+  const std::string svg =
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 100 100\"><path d=\"M 10 50 A 40 40 0 1 0 90 50 "
+      "A 40 40 0 1 0 10 50 Z M 12 50 A 38 38 0 1 1 88 50 A 38 38 0 1 1 12 50 Z\"/></svg>";
+  CurveBoundary curve(parse_svg(svg, "annulus"));
+  REQUIRE(curve.n_holes() == 1);
+  curve.set_global_level(3.0);
+  Options2d opt;
+  opt.level = 3.0;
+  opt.keep_stages = false;
+  Options2d no_retry = opt;
+  no_retry.thin_retry_boost = CurveBoundary::floor_boost_default;
+  std::string what;
+  try {
+    mesh2d(curve, no_retry);
+  } catch (const GeometryError& e) {
+    what = e.what();
+  }
+  CHECK(what.find("projects onto two loops") != std::string::npos);
+  const Result2d r = mesh2d(curve, opt);
+  CHECK(r.thin_parts_refined);
+  ValidateOptions<2> vo;
+  vo.expected_euler = 0;
+  vo.boundary_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
+  vo.boundary_tolerance = 1e-10 * 80.0;
+  const ValidationReport v = validate<2>(r.fe.mesh, vo);
+  INFO(v.summary());
+  CHECK(v.valid);
+  // A run the floors resolve makes no retry.
+  curve.set_global_level(5.0);
+  opt.level = 5.0;
+  CHECK_FALSE(mesh2d(curve, opt).thin_parts_refined);
 }
 
 TEST_CASE("mesh2d is deterministic", "[pipeline2d]") {
