@@ -269,14 +269,16 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     if (progress)
       progress(std::string(e.what()) + "; once more with the thickness rule up to " +
                std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked");
+    const std::string retried = std::string(e.what()) + "; with the thickness rule up to " +
+                                std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked: ";
     try {
       Result2d r = mesh2d_once(curve, opt, progress, opt.thin_retry_boost);
       r.thin_parts_refined = true;
       return r;
     } catch (const GeometryError& again) {
-      throw GeometryError(std::string(e.what()) + "; with the thickness rule up to " +
-                          std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked: " +
-                          again.what());
+      throw GeometryError(retried + again.what());
+    } catch (const LimitError& again) {  // the finer tree over max_cells: still a bound, named as such
+      throw LimitError(retried + again.what());
     }
   }
 }
