@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "core/quality.hpp"
 #include "core/error.hpp"
+#include "core/quality.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
 #include "dim2/curve_boundary.hpp"
@@ -184,9 +184,10 @@ TEST_CASE("a bend tighter than the quadrants is refined even with a given level"
 }
 
 // An annulus 2 thick and 80 across at level 3: the thickness floor (quadrants a quarter of the
-// thickness) stops 4 levels beyond the level asked, where a quadrant is 0.82, and refining
-// around the chains that project onto both loops went past the 12 repairs: refused (before
-// session 43 for good). The retry lets the floor go 8 levels beyond: meshed, valid.
+// thickness) stops 4 levels beyond the level asked, where a quadrant is 84 / 2^7 = 0.66 (3 across
+// the ring), and refining around the chains that project onto both loops went past the 12
+// repairs: refused (before session 43 for good). The retry lets the floor go 8 levels beyond:
+// meshed, valid.
 TEST_CASE("a part thinner than the floors' finest quadrants is meshed by the thin-parts retry", "[pipeline2d]") {
   const std::string svg =
       "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 100 100\"><path d=\"M 10 50 A 40 40 0 1 0 90 50 "
