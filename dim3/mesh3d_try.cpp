@@ -1,7 +1,6 @@
 #include "dim3/mesh3d_try.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -821,7 +820,7 @@ Result3d mesh3d_once(SurfaceBoundary& s, const Options3d& opt, Effort& effort, c
   if (r.fe.mesh.solid.empty()) {
     std::ostringstream why;
     why << "no interior octant: every part of the solid is thinner than the octants ("
-        << s.root_box().extent().maxCoeff() / std::exp2(opt.level) << " across; a finer --level or --size meshes it)";
+        << s.octant_side(opt.level) << " across; a finer --level or --size meshes it)";
     throw GeometryError(why.str());
   }
   return r;

@@ -170,7 +170,7 @@ Options3d thickness_try_options(const Options3d& opt) {
 bool thickness_try_applies(SurfaceBoundary& s, const Options3d& opt) {
   const double cells = opt.refused_thickness_cells;
   if (!(cells > 0)) return false;
-  const double h_feature = s.root_box().extent()[0] / std::ldexp(1.0, opt.level + 1);
+  const double h_feature = s.octant_side(opt.level + 1);
   return s.thin_share(cells * h_feature) > 0;
 }
 
@@ -459,7 +459,7 @@ Drawn run_drawn(SurfaceBoundary& s, const Options3d& opt, int k, std::size_t lim
 void set_level_of(Result3d& r, const SurfaceBoundary& s, int level) {
   r.level = level;
   r.root_scale = s.root_scale();
-  r.cell_size = s.root_box().extent()[0] / std::ldexp(1.0, level);
+  r.cell_size = s.octant_side(level);
 }
 
 /// What is left of a draw's work bound for the next one (0 when nothing is: no draw).

@@ -15,6 +15,7 @@
 //     thickness_max_level (set_thickness_level),
 // the others capped by max_level (set_max_level).
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,8 @@ class SurfaceBoundary final : public Boundary<3> {
   /// Smallest cube around the bounding box, enlarged by 5% and by SurfaceOptions::root_scale,
   /// same centre, shifted by SurfaceOptions::root_shift.
   Box<3> root_box() const;
+  /// The side of an octant at `level`: root_box()'s x extent / 2^level.
+  double octant_side(int level) const { return root_box().extent()[0] / std::ldexp(1.0, level); }
   /// SurfaceOptions::root_scale (>= 1); the curvature and thickness levels follow the new side.
   void set_root_scale(double scale);
   double root_scale() const { return options_.root_scale; }
