@@ -378,7 +378,7 @@ QuadrantComplexResult build_quadrant_complex(const Orthtree<2>& t, const Flags& 
     bool mixed = false;
     for (std::size_t k = 0; k < m; ++k) {
       if (cp[k].where.patch != loop) {
-        res.problems.push_back({qc.points[ch.q[k]], "a chain of free edges projects onto two loops"});
+        res.problems.push_back({qc.points[ch.q[k]], two_loops_problem});
         mixed = true;
       }
     }

@@ -43,6 +43,10 @@ struct Problem {
   std::string what;
 };
 
+/// Problem::what of a chain of free edges whose nodes project onto two loops: a part thinner
+/// than the quadrants there (mesh2d's thin-parts retry looks for it).
+inline constexpr char two_loops_problem[] = "a chain of free edges projects onto two loops";
+
 struct QuadrantComplexResult {
   QuadrantComplex complex;
   BoundaryQuadrantStats stats;

@@ -240,8 +240,7 @@ Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Pro
     if (last || !mark_around<2>(tree, places, 2.0, opt.max_level, flags)) {
       const std::string why = "the boundary quadrants cannot be built after " + std::to_string(r.n_repairs) +
                               " local refinements (max level " + std::to_string(opt.max_level) + "): " + describe(problems);
-      if (std::any_of(problems.begin(), problems.end(),
-                      [](const Problem& p) { return p.what.find("onto two loops") != std::string::npos; }))
+      if (std::any_of(problems.begin(), problems.end(), [](const Problem& p) { return p.what == two_loops_problem; }))
         throw ThinPartsRefusal(why);
       throw GeometryError(why);
     }
@@ -266,19 +265,17 @@ Result2d mesh2d(const CurveBoundary& curve, const Options2d& opt, const Progress
     // across, at --size 10: refused after 12 repairs; at 9 meshed). Only after such a refusal,
     // so that every mesh made before stays the same; automatic levels have no such stop.
     if (curve.is_automatic() || !(opt.thin_retry_boost > CurveBoundary::floor_boost_default)) throw;
-    if (progress)
-      progress(std::string(e.what()) + "; once more with the thickness rule up to " +
-               std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked");
-    const std::string retried = std::string(e.what()) + "; with the thickness rule up to " +
-                                std::to_string(static_cast<int>(opt.thin_retry_boost)) + " levels beyond the level asked: ";
+    const std::string rule = "with the thickness rule up to " + std::to_string(static_cast<int>(opt.thin_retry_boost)) +
+                             " levels beyond the level asked";
+    if (progress) progress(std::string(e.what()) + "; once more " + rule);
     try {
       Result2d r = mesh2d_once(curve, opt, progress, opt.thin_retry_boost);
       r.thin_parts_refined = true;
       return r;
     } catch (const GeometryError& again) {
-      throw GeometryError(retried + again.what());
+      throw GeometryError(std::string(e.what()) + "; " + rule + ": " + again.what());
     } catch (const LimitError& again) {  // the finer tree over max_cells: still a bound, named as such
-      throw LimitError(retried + again.what());
+      throw LimitError(std::string(e.what()) + "; " + rule + ": " + again.what());
     }
   }
 }
