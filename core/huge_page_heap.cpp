@@ -83,13 +83,21 @@ void reexec_with_huge_page_heap(char** argv) {
 #endif
 }
 
+void set_up_malloc() {
+#if defined(__GLIBC__)
+  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (!tunable_is_set(tunables, "glibc.malloc.arena_max")) mallopt(M_ARENA_MAX, 1);
+  if (!tunable_is_set(tunables, "glibc.malloc.mmap_threshold")) mallopt(M_MMAP_THRESHOLD, static_cast<int>(own_mapping_bytes));
+#endif
+}
+
 void set_up_heap(char** argv) {
 #if defined(__GLIBC__) && defined(__linux__)
   if (huge_page_heap_wanted()) reexec_with_huge_page_heap(argv);
-  if (!tunable_is_set(std::getenv("GLIBC_TUNABLES"), "glibc.malloc.arena_max")) mallopt(M_ARENA_MAX, 1);
 #else
   (void)argv;
 #endif
+  set_up_malloc();
 }
 
 }  // namespace febemesh

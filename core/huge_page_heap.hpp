@@ -1,6 +1,8 @@
 #pragma once
-// The process's malloc: one arena, and transparent huge pages on request (issue 8).
+// The process's malloc: one arena, large blocks mapped on their own, and transparent huge pages
+// on request (issue 8).
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
@@ -24,9 +26,24 @@ std::optional<std::string> tunables_with_huge_page_heap(const char* current);
 /// GLIBC_TUNABLES only when it starts, and mallopt has no huge-page setting.
 void reexec_with_huge_page_heap(char** argv);
 
-/// The process's malloc set-up; call it first thing in main. On glibc: one arena for every
-/// thread (mallopt, unless GLIBC_TUNABLES sets an arena count), and, unless
-/// FEBEMESH_HUGE_PAGES=0, the restart of reexec_with_huge_page_heap (huge_page_heap_wanted).
+/// Blocks of this size and more get a mapping of their own when the heap has no free room for
+/// them (glibc's mmap threshold), given back to the kernel when freed. glibc's own threshold
+/// rises to the largest mapped block freed (up to 32 MiB), so a mesh's per-element arrays came
+/// from the heap, whose freed middle stays resident. Measured (session 44, one thread):
+/// bench_mesh3d sphere966 at 995,249 tets, peak RSS growth 103.1-105.2 MB with glibc's
+/// threshold, 93.7-94.0 with 8 MiB (4 MiB 93.8-96.0, 2 MiB 92.2-92.7, 1 MiB 88.9-90.8), the
+/// same time; at 4,941,815 tets 465.7-472.3 -> 448.8-448.9 MB. Each fresh mapping costs page
+/// faults: fandisk level 5 (CLI) spends 0.22-0.39 s in the kernel with glibc's threshold,
+/// 0.29-0.32 with 8 MiB, 0.45-0.47 with 4 MiB, 1.55 with 2 MiB, 2.0 with 1 MiB.
+inline constexpr std::size_t own_mapping_bytes = std::size_t{8} << 20;
+
+/// On glibc, mallopt: one arena for every thread (unless GLIBC_TUNABLES sets an arena count) and
+/// blocks of own_mapping_bytes and more mapped on their own (unless GLIBC_TUNABLES sets
+/// glibc.malloc.mmap_threshold). Elsewhere nothing.
+void set_up_malloc();
+
+/// The process's malloc set-up; call it first thing in main: unless FEBEMESH_HUGE_PAGES=0, the
+/// restart of reexec_with_huge_page_heap (huge_page_heap_wanted), then set_up_malloc.
 ///
 /// One arena: with an arena a thread, the second thread's blocks did not reuse what the first
 /// had freed (bench_mesh3d sphere966 L6 on two threads: peak 154 -> 142-144 MB, the same time).

@@ -142,8 +142,8 @@ TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") 
 TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart", "[cli][mesh2d]") {
   // By default (and with FEBEMESH_HUGE_PAGES=1) the program starts itself again with
   // glibc.malloc.hugetlb=1, unless GLIBC_TUNABLES sets the tunable already: the same arguments,
-  // the same mesh. With FEBEMESH_HUGE_PAGES=0 no restart; one malloc arena either way, unless
-  // GLIBC_TUNABLES sets one.
+  // the same mesh. With FEBEMESH_HUGE_PAGES=0 no restart; one malloc arena and an 8 MiB mmap
+  // threshold either way, unless GLIBC_TUNABLES sets them.
   const auto dir = scratch("hugepages");
   const std::string args = "mesh2d '" + flange + "' --level 6 --quiet -o '";
   REQUIRE(run(args + (dir / "default").string() + "'").status == 0);
@@ -151,12 +151,15 @@ TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart
   REQUIRE(run(args + (dir / "small").string() + "'", "FEBEMESH_HUGE_PAGES=0").status == 0);
   REQUIRE(run(args + (dir / "preset").string() + "'", "FEBEMESH_HUGE_PAGES=1 GLIBC_TUNABLES=glibc.malloc.hugetlb=0").status == 0);
   REQUIRE(run(args + (dir / "arenas").string() + "'", "GLIBC_TUNABLES=glibc.malloc.arena_max=4").status == 0);
+  // glibc's own mmap threshold instead of set_up_malloc's (own_mapping_bytes).
+  REQUIRE(run(args + (dir / "mapped").string() + "'", "GLIBC_TUNABLES=glibc.malloc.mmap_threshold=131072").status == 0);
   const std::string a = read_text(dir / "default" / "mesh.msh");
   CHECK(a.size() > 10000);
   CHECK(a == read_text(dir / "huge" / "mesh.msh"));
   CHECK(a == read_text(dir / "small" / "mesh.msh"));
   CHECK(a == read_text(dir / "preset" / "mesh.msh"));
   CHECK(a == read_text(dir / "arenas" / "mesh.msh"));
+  CHECK(a == read_text(dir / "mapped" / "mesh.msh"));
   const Run help = run("--help");
   CHECK(help.output.find("FEBEMESH_HUGE_PAGES") != std::string::npos);
   // Started through the dynamic loader, /proc/self/exe is the loader: no restart then (it would
