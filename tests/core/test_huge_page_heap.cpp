@@ -72,6 +72,7 @@ TEST_CASE("set_up_malloc's mapping rule, in a fresh process", "[.][malloc_child]
 }
 
 TEST_CASE("set_up_malloc maps every large block on its own and gives it back when freed", "[huge_pages]") {
+  if (test::sanitized()) return;  // the sanitizer's allocator, whichever compiler built it
   if (tunable_is_set(std::getenv("GLIBC_TUNABLES"), "glibc.malloc.mmap_threshold")) {
     WARN("GLIBC_TUNABLES sets glibc.malloc.mmap_threshold: set_up_malloc leaves it");
     return;

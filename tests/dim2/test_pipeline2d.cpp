@@ -17,6 +17,7 @@
 #include "dim2/pipeline2d.hpp"
 #include "dim2/read_domain.hpp"
 #include "dim2/read_svg.hpp"
+#include "thrown.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim2;
@@ -200,12 +201,7 @@ TEST_CASE("a part thinner than the floors' finest quadrants is meshed by the thi
   opt.keep_stages = false;
   Options2d no_retry = opt;
   no_retry.thin_retry_boost = CurveBoundary::floor_boost_default;
-  std::string what;
-  try {
-    mesh2d(curve, no_retry);
-  } catch (const GeometryError& e) {
-    what = e.what();
-  }
+  const std::string what = test::thrown_message<GeometryError>([&] { mesh2d(curve, no_retry); });
   CHECK(what.find("projects onto two loops") != std::string::npos);
   const Result2d r = mesh2d(curve, opt);
   CHECK(r.thin_parts_refined);

@@ -21,6 +21,7 @@
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_checks.hpp"
 #include "dim3/tet_optimize.hpp"
+#include "thrown.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -114,12 +115,7 @@ TEST_CASE("mesh3d: a torus thinner than the octants is meshed, not left empty", 
   bare.coarse_thin_after_refusal = false;
   bare.refused_thickness_cells = 0.0;
   bare.align_planar_faces = false;
-  std::string what;
-  try {
-    mesh3d(s, bare);
-  } catch (const GeometryError& e) {
-    what = e.what();
-  }
+  const std::string what = test::thrown_message<GeometryError>([&] { mesh3d(s, bare); });
   CHECK(what.find("no interior octant") != std::string::npos);
 }
 
@@ -149,12 +145,7 @@ TEST_CASE("the work bound stops the repairs of mesh3d with LimitError", "[pipeli
   }
   opt.effort = 2.0;
   SurfaceBoundary s = SurfaceBoundary::from_file(file);
-  std::string what;
-  try {
-    mesh3d(s, opt);
-  } catch (const LimitError& e) {
-    what = e.what();
-  }
+  const std::string what = test::thrown_message<LimitError>([&] { mesh3d(s, opt); });
   INFO(what);
   CHECK(what.find("over its work bound of 6176") != std::string::npos);
 }
@@ -178,13 +169,7 @@ TEST_CASE("mesh3d tries the thickness level once after a refusal of a thin part"
     opt.min_effort_octants = 0;
     opt.raise_levels = 0;
     opt.refused_thickness_cells = cells;
-    std::string what;
-    try {
-      mesh3d(s, opt);
-    } catch (const LimitError& e) {
-      what = e.what();
-    }
-    return what;
+    return test::thrown_message<LimitError>([&] { mesh3d(s, opt); });
   };
   const std::string with = refusal(4.0), without = refusal(0.0);
   INFO(with);

@@ -66,6 +66,7 @@
 #include "dim3/fidelity3d.hpp"
 #include "dim3/pipeline3d.hpp"
 #include "dim3/planar_frame.hpp"
+#include "thrown.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -179,13 +180,7 @@ TEST_CASE("mesh3d data: the thickness probe ends after a first round of untangli
     opt.snap_features = false;  // one try: no fallback
     opt.refused_thickness_cells = 0.0;
     opt.first_round_inverted_share = share;
-    std::string what;
-    try {
-      mesh3d(s, opt);
-    } catch (const GeometryError& e) {
-      what = e.what();
-    }
-    return what;
+    return test::thrown_message<GeometryError>([&] { mesh3d(s, opt); });
   };
   const std::string early = refusal(0.02), late = refusal(0.0);
   INFO(early);
