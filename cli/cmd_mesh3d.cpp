@@ -22,6 +22,7 @@
 #include "cli/size_option.hpp"
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
+#include "core/process_stats.hpp"
 #include "core/quality.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
@@ -401,6 +402,12 @@ int run(const std::vector<std::string>& argv) {
   // Reading to the report, writing mesh.msh and mesh.vtu included.
   times["total"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   rep["timings_s"] = times;
+  // As mesh2d's report: the process's peak resident memory so far (reading to the report), and
+  // the solid elements per second of the total.
+  rep["peak_memory_bytes"] = peak_memory_bytes();
+  const std::size_t n_elements = opt.hex_dominant ? r.hex.n_elements() : mesh.solid.size();
+  const double total = times["total"].get<double>();
+  rep["elements_per_second"] = total > 0.0 ? static_cast<double>(n_elements) / total : 0.0;
   rep["quality"] = quality_json(q);
   if (opt.hex_dominant)
     rep["hex_dominant"] = {{"hexahedra", r.hex.n_hex},

@@ -72,6 +72,12 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
   const auto times = nlohmann::json::parse(read_text(dir / "1" / "report.json"))["timings_s"];
   for (const char* stage : {"validation", "quality summary", "tries_not_kept"}) CHECK(times.contains(stage));
   CHECK(times["validation"].get<double>() > 0.0);
+  // The process's peak memory and the rate, as mesh2d's report has them: the peak holds at
+  // least the tetrahedra's node ids.
+  const auto rep = nlohmann::json::parse(read_text(dir / "1" / "report.json"));
+  const double n_tets = rep["counts"]["tetrahedra"].get<double>();
+  CHECK(rep["peak_memory_bytes"].get<double>() > 16.0 * n_tets);
+  CHECK(rep["elements_per_second"].get<double>() == Approx(n_tets / times["total"].get<double>()));
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --effort 0.5") == 2);
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --threads 0") == 2);
   CHECK(!std::filesystem::exists(dir / "0"));
