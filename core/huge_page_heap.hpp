@@ -34,7 +34,9 @@ void reexec_with_huge_page_heap(char** argv);
 /// threshold, 93.7-94.0 with 8 MiB (4 MiB 93.8-96.0, 2 MiB 92.2-92.7, 1 MiB 88.9-90.8), the
 /// same time; at 4,941,815 tets 465.7-472.3 -> 448.8-448.9 MB. Each fresh mapping costs page
 /// faults: fandisk level 5 (CLI) spends 0.22-0.39 s in the kernel with glibc's threshold,
-/// 0.29-0.32 with 8 MiB, 0.45-0.47 with 4 MiB, 1.55 with 2 MiB, 2.0 with 1 MiB.
+/// 0.29-0.35 with 8 MiB, 0.43-0.47 with 4 MiB, 1.55 with 2 MiB, 2.0 with 1 MiB. How much of the
+/// freed heap stays resident still depends on what the process did before: 10^6 after 10^5 in
+/// one bench run grows 104.5 MB with 8 MiB, 95.4 with 4 MiB, which is 5% slower at 10^6 alone.
 inline constexpr std::size_t own_mapping_bytes = std::size_t{8} << 20;
 
 /// On glibc, mallopt: one arena for every thread (unless GLIBC_TUNABLES sets an arena count) and
