@@ -37,7 +37,9 @@ void print_overview(std::ostream& os) {
         "environment: the program starts again once with GLIBC_TUNABLES=glibc.malloc.hugetlb=1\n"
         "  (malloc on 2 MiB pages: 15-25% faster on this machine's benchmarks) unless\n"
         "  FEBEMESH_HUGE_PAGES=0 or GLIBC_TUNABLES sets the tunable; FEBEMESH_HUGE_PAGES=1 also\n"
-        "  advises the large arrays (madvise); the same meshes either way\n";
+        "  advises the large arrays (madvise); blocks of 8 MiB and more are mapped on their own\n"
+        "  and given back when freed (glibc.malloc.mmap_threshold in GLIBC_TUNABLES sets another\n"
+        "  size); the same meshes either way\n";
 }
 
 }  // namespace

@@ -162,6 +162,7 @@ TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart
   CHECK(a == read_text(dir / "mapped" / "mesh.msh"));
   const Run help = run("--help");
   CHECK(help.output.find("FEBEMESH_HUGE_PAGES") != std::string::npos);
+  CHECK(help.output.find("glibc.malloc.mmap_threshold") != std::string::npos);
   // Started through the dynamic loader, /proc/self/exe is the loader: no restart then (it would
   // run the loader with the arguments).
   for (const char* loader : {"/lib64/ld-linux-x86-64.so.2", "/lib/ld-linux-aarch64.so.1"}) {
