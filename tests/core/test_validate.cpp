@@ -481,7 +481,7 @@ TEST_CASE("bucketed facet groups give the slow twin's report: triangles and quad
     ValidateOptions<Dim> vo;
     vo.expected_euler = 1;
     vo.max_problems = 1000;
-    for (const int threads : {1, 2}) {
+    for (const int threads : {1, 2, 3}) {
       vo.n_threads = threads;
       vo.bucketed_facets = false;
       const ValidationReport twin = validate<Dim>(mesh, vo);
@@ -499,6 +499,11 @@ TEST_CASE("bucketed facet groups give the slow twin's report: triangles and quad
   };
   check(test::grid_mesh<2>(7, true));
   check(test::grid_mesh<2>(7, false));
+  // 80,000 triangles and 67,600 quads: the uses are bucketed by ranges of the elements, one a
+  // thread, and the groups reported by chunks of buckets on the threads; a facet's three uses
+  // (an element listed again at the end) span the ranges.
+  check(test::grid_mesh<2>(200, true));
+  check(test::grid_mesh<2>(260, false));
   check(test::hanging_mesh<2>(true));
   check(test::hanging_mesh<2>(false));
   check(test::grid_mesh<3>(4, true));
