@@ -182,6 +182,10 @@ int run(const std::vector<std::string>& argv) {
   }
   if (!valid.valid && !args.has("--no-validate"))
     throw std::runtime_error("the mesh of " + input + " failed validation (please report):\n" + valid.summary());
+  // The quality section's measures, in the run's time (beside the writing on 2+ threads).
+  t0 = std::chrono::steady_clock::now();
+  const Quality2d quality = measure_quality(r.fe.mesh, curve, opt.n_threads);
+  info.steps.push_back({"quality summary", since(t0)});
   writing.get();  // rethrows a write error (one thread: writes now)
   info.steps.push_back({"write mesh.msh and mesh.vtu", t_write});  // beside the checks on 2+ threads
   if (r.stages_kept) write_stage_figures(r, curve, dir.file("figures"));
@@ -194,7 +198,7 @@ int run(const std::vector<std::string>& argv) {
   {
     std::ofstream rep(dir.file("report.json"));
     // The CLI's own options (figures, MSH encoding) join the library's in "options".
-    nlohmann::ordered_json j = nlohmann::ordered_json::parse(report_json(r, curve, opt, fid, valid, info));
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(report_json(r, curve, opt, fid, quality, valid, info));
     j["options"]["size"] = size > 0 ? nlohmann::ordered_json(size) : nlohmann::ordered_json(nullptr);
     j["options"]["root_scale"] = curve.root_scale();
     j["options"]["figures"] = figures;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/distance.hpp"
+#include "core/parallel_ranges.hpp"
 #include "core/quality.hpp"
 #include "dim2/improve2d.hpp"
 #include "dim2/loop_geometry.hpp"
@@ -17,7 +18,7 @@ namespace febemesh::dim2 {
 // 1 + c^2, far beyond the ~1e-15 at which a quotient and atan2 can disagree on the order) get
 // their corners' angles; the bounds are the same numbers as from every element's.
 AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve,
-                                                     double sharp_deg) {
+                                                     double sharp_deg, int n_threads) {
   // Exempt radius in element sizes: 8, or the distance from the tip at which the corner's
   // wedge is 4 element sizes wide (w = 2 r tan(a/2)), whichever is larger; inside it the
   // wedge, not the mesher, sets the angles.
@@ -51,58 +52,84 @@ AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const Cur
     }
     return r;
   };
-  std::vector<std::uint8_t> away(m.solid.size(), 0);
-  double top_tri = -inf, top_quad = -inf, bottom_quad = inf;  // over finite cotangents
-  for (std::size_t e = 0; e < m.solid.size(); ++e) {
-    const ElemId id{static_cast<std::int32_t>(e)};
-    const int n = m.solid.n_nodes_of(id);
-    const VertexId* v = m.solid.nodes(id);
-    if (exempt(v, n)) {
-      ++out.n_exempt;
-      continue;
+  // Both passes in fixed chunks on n_threads threads, each with its own extremes and count
+  // (maxima, minima and integer counts: the same numbers for every thread count).
+  const std::size_t n_elems = m.solid.size();
+  const std::size_t chunk = chunk_size(n_elems, n_threads, std::size_t(1) << 14);
+  const std::size_t n_chunks = (n_elems + chunk - 1) / chunk;
+  struct Part {
+    double top_tri = -inf, top_quad = -inf, bottom_quad = inf;  // over finite cotangents
+    AnglesAwayFromCorners a;
+  };
+  std::vector<Part> parts(n_chunks);
+  std::vector<std::uint8_t> away(n_elems, 0);
+  for_each_chunk(n_elems, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    Part& p = parts[c];
+    for (std::size_t e = begin; e < end; ++e) {
+      const ElemId id{static_cast<std::int32_t>(e)};
+      const int n = m.solid.n_nodes_of(id);
+      const VertexId* v = m.solid.nodes(id);
+      if (exempt(v, n)) {
+        ++p.a.n_exempt;
+        continue;
+      }
+      away[e] = 1;
+      const auto [top, bottom] = cot_range(v, n);
+      if (!std::isfinite(top)) continue;
+      if (n == 3) {
+        p.top_tri = std::max(p.top_tri, top);
+      } else {
+        p.top_quad = std::max(p.top_quad, top);
+        p.bottom_quad = std::min(p.bottom_quad, bottom);
+      }
     }
-    away[e] = 1;
-    const auto [top, bottom] = cot_range(v, n);
-    if (!std::isfinite(top)) continue;
-    if (n == 3) {
-      top_tri = std::max(top_tri, top);
-    } else {
-      top_quad = std::max(top_quad, top);
-      bottom_quad = std::min(bottom_quad, bottom);
-    }
+  });
+  double top_tri = -inf, top_quad = -inf, bottom_quad = inf;
+  for (const Part& p : parts) {
+    top_tri = std::max(top_tri, p.top_tri), top_quad = std::max(top_quad, p.top_quad);
+    bottom_quad = std::min(bottom_quad, p.bottom_quad);
+    out.n_exempt += p.a.n_exempt;
   }
   auto within = [](double c, double extreme) { return std::abs(c - extreme) <= 1e-9 * (1.0 + extreme * extreme); };
-  for (std::size_t e = 0; e < m.solid.size(); ++e) {
-    if (!away[e]) continue;
-    const ElemId id{static_cast<std::int32_t>(e)};
-    const int n = m.solid.n_nodes_of(id);
-    const VertexId* v = m.solid.nodes(id);
-    const auto [top, bottom] = cot_range(v, n);
-    const bool measured = !std::isfinite(top) ||
-                          (n == 3 ? within(top, top_tri) : within(top, top_quad) || within(bottom, bottom_quad));
-    if (!measured) continue;
-    double lo = 180.0, hi = 0.0;
-    for (int k = 0; k < n; ++k) {
-      const P2 a = m.points[v[(k + n - 1) % n].v] - m.points[v[k].v], b = m.points[v[(k + 1) % n].v] - m.points[v[k].v];
-      const double cr = b[0] * a[1] - b[1] * a[0];
-      // A reflex or inverted corner counts as 0 deg (the worst) for both bounds.
-      const double ang = cr > 0 ? std::atan2(cr, a.dot(b)) * 180.0 / M_PI : 0.0;
-      lo = std::min(lo, ang);
-      hi = std::max(hi, cr > 0 ? ang : 180.0);
+  for_each_chunk(n_elems, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
+    AnglesAwayFromCorners& a = parts[c].a;
+    for (std::size_t e = begin; e < end; ++e) {
+      if (!away[e]) continue;
+      const ElemId id{static_cast<std::int32_t>(e)};
+      const int n = m.solid.n_nodes_of(id);
+      const VertexId* v = m.solid.nodes(id);
+      const auto [top, bottom] = cot_range(v, n);
+      const bool measured = !std::isfinite(top) ||
+                            (n == 3 ? within(top, top_tri) : within(top, top_quad) || within(bottom, bottom_quad));
+      if (!measured) continue;
+      double lo = 180.0, hi = 0.0;
+      for (int k = 0; k < n; ++k) {
+        const P2 pa = m.points[v[(k + n - 1) % n].v] - m.points[v[k].v], pb = m.points[v[(k + 1) % n].v] - m.points[v[k].v];
+        const double cr = pb[0] * pa[1] - pb[1] * pa[0];
+        // A reflex or inverted corner counts as 0 deg (the worst) for both bounds.
+        const double ang = cr > 0 ? std::atan2(cr, pa.dot(pb)) * 180.0 / M_PI : 0.0;
+        lo = std::min(lo, ang);
+        hi = std::max(hi, cr > 0 ? ang : 180.0);
+      }
+      if (n == 3) {
+        a.min_triangle_deg = std::min(a.min_triangle_deg, lo);
+      } else {
+        a.min_quad_deg = std::min(a.min_quad_deg, lo);
+        a.max_quad_deg = std::max(a.max_quad_deg, hi);
+      }
     }
-    if (n == 3) {
-      out.min_triangle_deg = std::min(out.min_triangle_deg, lo);
-    } else {
-      out.min_quad_deg = std::min(out.min_quad_deg, lo);
-      out.max_quad_deg = std::max(out.max_quad_deg, hi);
-    }
+  });
+  for (const Part& p : parts) {
+    out.min_triangle_deg = std::min(out.min_triangle_deg, p.a.min_triangle_deg);
+    out.min_quad_deg = std::min(out.min_quad_deg, p.a.min_quad_deg);
+    out.max_quad_deg = std::max(out.max_quad_deg, p.a.max_quad_deg);
   }
   return out;
 }
 
 double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
-                                         std::size_t* n_exempt) {
-  const AnglesAwayFromCorners a = angles_away_from_sharp_corners(m, curve, sharp_deg);
+                                         std::size_t* n_exempt, int n_threads) {
+  const AnglesAwayFromCorners a = angles_away_from_sharp_corners(m, curve, sharp_deg, n_threads);
   if (n_exempt) *n_exempt = a.n_exempt;
   return std::min(a.min_triangle_deg, a.min_quad_deg);
 }

@@ -23,9 +23,10 @@ struct Fidelity2d {
 /// sharper than `sharp_deg` (the quality bar exempts those corners: no element there can beat
 /// the corner's own angle). "Away" = farther than max(8, 2 / tan(angle / 2)) of the element's
 /// own sizes: 8 sizes, or the part of the corner's wedge thinner than 4 element sizes. Also
-/// returns how many elements were exempt through `n_exempt`.
+/// returns how many elements were exempt through `n_exempt`. On n_threads threads (the same
+/// numbers for every count).
 double min_angle_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
-                                         std::size_t* n_exempt = nullptr);
+                                         std::size_t* n_exempt = nullptr, int n_threads = 1);
 
 /// Corner angles (degrees) over the elements away from sharp corners, as above, by kind: the
 /// triangles' smallest angle and the quads' smallest and largest (the bars are >= 20 deg for
@@ -36,7 +37,8 @@ struct AnglesAwayFromCorners {
   double max_quad_deg = 0.0;
   std::size_t n_exempt = 0;
 };
-AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg);
+AnglesAwayFromCorners angles_away_from_sharp_corners(const Mesh<2>& m, const CurveBoundary& curve, double sharp_deg,
+                                                     int n_threads = 1);
 
 /// `samples` curve points per BE edge for the Hausdorff estimate (one-sided from the curve,
 /// which dominates: the BE edges are chords of the curve).

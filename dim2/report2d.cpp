@@ -1,5 +1,7 @@
 #include "dim2/report2d.hpp"
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "core/quality.hpp"
@@ -7,11 +9,20 @@
 
 namespace febemesh::dim2 {
 
+Quality2d measure_quality(const Mesh<2>& m, const CurveBoundary& curve, int n_threads) {
+  Quality2d q;
+  q.summary = summarize_quality<2>(m, 20.0, n_threads);
+  q.min_angle_away_deg = min_angle_away_from_sharp_corners(m, curve, 20.0, &q.n_near_sharp_corners, n_threads);
+  if (std::any_of(m.solid.type.begin(), m.solid.type.end(), [](ElemType t) { return t == ElemType::Quad4; }))
+    q.quad_bar = angles_away_from_sharp_corners(m, curve, 30.0, n_threads);  // the quad bar, [30, 150] deg
+  return q;
+}
+
 std::string report_json(const Result2d& r, const CurveBoundary& curve, const Options2d& opt, const Fidelity2d& fid,
-                        const ValidationReport& valid, const RunInfo& info) {
+                        const Quality2d& quality2d, const ValidationReport& valid, const RunInfo& info) {
   using nlohmann::ordered_json;
   const Mesh<2>& m = r.fe.mesh;
-  const QualitySummary q = summarize_quality<2>(m, 20.0);
+  const QualitySummary& q = quality2d.summary;
   std::size_t n_tri = 0, n_quad = 0;
   for (ElemType t : m.solid.type) (t == ElemType::Tri3 ? n_tri : n_quad)++;
   std::size_t n_in = 0;
@@ -61,14 +72,10 @@ std::string report_json(const Result2d& r, const CurveBoundary& curve, const Opt
   ordered_json quality;
   quality["min_angle_deg"] = q.min_angle_deg;
   quality["max_angle_deg"] = q.max_angle_deg;
-  std::size_t n_exempt = 0;
-  quality["min_angle_away_from_sharp_corners_deg"] = min_angle_away_from_sharp_corners(m, curve, 20.0, &n_exempt);
-  quality["elements_near_sharp_corners"] = n_exempt;
-  if (n_quad > 0) {
-    // The quad bar, [30, 150] deg, away from input corners sharper than 30 deg.
-    const AnglesAwayFromCorners a = angles_away_from_sharp_corners(m, curve, 30.0);
-    quality["quad_angle_range_away_from_sharp_corners_deg"] = {a.min_quad_deg, a.max_quad_deg};
-  }
+  quality["min_angle_away_from_sharp_corners_deg"] = quality2d.min_angle_away_deg;
+  quality["elements_near_sharp_corners"] = quality2d.n_near_sharp_corners;
+  if (quality2d.quad_bar)
+    quality["quad_angle_range_away_from_sharp_corners_deg"] = {quality2d.quad_bar->min_quad_deg, quality2d.quad_bar->max_quad_deg};
   quality["min_scaled_jacobian"] = q.min_scaled_jacobian;
   quality["mean_scaled_jacobian"] = q.mean_scaled_jacobian;
   quality["max_aspect_ratio"] = q.max_aspect_ratio;

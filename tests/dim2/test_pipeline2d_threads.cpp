@@ -11,6 +11,7 @@
 #include "dim2/improve2d.hpp"
 #include "dim2/pipeline2d.hpp"
 #include "dim2/read_domain.hpp"
+#include "dim2/report2d.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim2;
@@ -127,4 +128,30 @@ TEST_CASE("stages are kept only up to keep_stages_max_elements", "[pipeline2d]")
   CHECK(!dropped.stages_kept);
   CHECK(dropped.complex.boundary.empty());
   CHECK(msh_string(dropped.fe.mesh) == msh_string(kept.fe.mesh));
+}
+
+TEST_CASE("report.json's quality measures are the same on 1, 2 and 3 threads", "[pipeline2d][threads]") {
+  // NACA 0012 in mixed elements: triangles and quads, and a 16.6 deg trailing edge whose
+  // elements are exempt; more than 4 chunks of 16,384 elements, so the extremes and the exempt
+  // count are combined over chunks.
+  const std::string file = example("naca0012.json");
+  const Result2d r = run(file, 10, ElementKind::Mixed, 1);
+  REQUIRE(r.fe.mesh.solid.size() > 4 * 16384);
+  const CurveBoundary curve(read_domain(file));
+  const Quality2d one = measure_quality(r.fe.mesh, curve, 1);
+  REQUIRE(one.n_near_sharp_corners > 0);
+  REQUIRE(one.quad_bar);
+  CHECK(one.min_angle_away_deg > one.summary.min_angle_deg);  // the trailing edge's angles are left out
+  for (const int threads : {2, 3}) {
+    INFO(threads << " threads");
+    const Quality2d more = measure_quality(r.fe.mesh, curve, threads);
+    CHECK(more.min_angle_away_deg == one.min_angle_away_deg);
+    CHECK(more.n_near_sharp_corners == one.n_near_sharp_corners);
+    CHECK(more.quad_bar->min_quad_deg == one.quad_bar->min_quad_deg);
+    CHECK(more.quad_bar->max_quad_deg == one.quad_bar->max_quad_deg);
+    CHECK(more.quad_bar->min_triangle_deg == one.quad_bar->min_triangle_deg);
+    CHECK(more.summary.min_angle_deg == one.summary.min_angle_deg);
+    CHECK(more.summary.mean_scaled_jacobian == one.summary.mean_scaled_jacobian);
+    CHECK(more.summary.n_slivers == one.summary.n_slivers);
+  }
 }
