@@ -89,6 +89,20 @@ template <int Dim> double angle_deg(const Point<Dim>& a, const Point<Dim>& b) {
   return std::acos(std::clamp(a.dot(b) / (na * nb), -1.0, 1.0)) * rad_to_deg;
 }
 
+/// The cosine of each corner angle of a polygon (Tri3, Quad4) in corners(t)'s order, as
+/// angle_deg takes it: the angle is angle_of_key(key); a corner with a zero edge has key 1
+/// (angle_deg's 0 degrees). Returns the number of corners.
+template <int Dim> int polygon_corner_keys(ElemType t, std::span<const Point<Dim>> p, double* key) {
+  int n = 0;
+  for (const Corner& k : corners(t)) {
+    const Point<Dim> a = p[k.a] - p[k.c], b = p[k.b] - p[k.c];
+    const double na = a.norm(), nb = b.norm();
+    key[n++] = na == 0.0 || nb == 0.0 ? 1.0 : std::clamp(a.dot(b) / (na * nb), -1.0, 1.0);
+  }
+  return n;
+}
+double angle_of_key(double key) { return std::acos(key) * rad_to_deg; }
+
 /// Newell normal of facet f (area-weighted, outward).
 Point<3> facet_normal(ElemType t, int f, std::span<const Point<3>> p) {
   const auto local = facet_local_nodes(t, f);
@@ -377,6 +391,19 @@ template <int Dim> double signed_measure(ElemType t, std::span<const Point<Dim>>
   }
 }
 
+namespace {
+
+/// element_quality's aspect ratio of a polygon (Verdict's, 1 = ideal).
+template <int Dim> double polygon_aspect_ratio(ElemType t, std::span<const Point<Dim>> p) {
+  double sum = 0.0;
+  const double longest = edge_length_range<Dim>(t, p, &sum).second;
+  const double area = std::abs(signed_measure<Dim>(t, p));
+  const double denom = (t == ElemType::Tri3 ? 4.0 * std::sqrt(3.0) : 4.0) * area;
+  return denom > 0.0 ? longest * sum / denom : inf;
+}
+
+}  // namespace
+
 template <int Dim> ElementQuality element_quality(ElemType t, std::span<const Point<Dim>> p) {
   ElementQuality q;
   q.scaled_jacobian = scaled_jacobian<Dim>(t, p);
@@ -388,16 +415,14 @@ template <int Dim> ElementQuality element_quality(ElemType t, std::span<const Po
   if (dimension(t) == 2) {
     q.min_angle_deg = inf;
     q.max_angle_deg = -inf;
-    for (const Corner& k : corners(t)) {
-      const double a = angle_deg<Dim>(p[k.a] - p[k.c], p[k.b] - p[k.c]);
+    double key[8];
+    const int n = polygon_corner_keys<Dim>(t, p, key);
+    for (int i = 0; i < n; ++i) {
+      const double a = angle_of_key(key[i]);
       q.min_angle_deg = std::min(q.min_angle_deg, a);
       q.max_angle_deg = std::max(q.max_angle_deg, a);
     }
-    double sum = 0.0;
-    const double longest = edge_length_range<Dim>(t, p, &sum).second;
-    const double area = std::abs(signed_measure<Dim>(t, p));
-    const double denom = (t == ElemType::Tri3 ? 4.0 * std::sqrt(3.0) : 4.0) * area;
-    q.aspect_ratio = denom > 0.0 ? longest * sum / denom : inf;
+    q.aspect_ratio = polygon_aspect_ratio<Dim>(t, p);
     return q;
   }
   if constexpr (Dim == 3) {
@@ -583,6 +608,133 @@ void summarize_tets(const Mesh<Dim>& mesh, std::size_t begin, std::size_t end, d
   }
 }
 
+/// One element's terms into p and sum_sj (its quality q and signed measure), the generic way.
+void add_element(const ElementQuality& q, double measure, double sliver_threshold_deg, QualitySummary& p, double& sum_sj) {
+  p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, q.scaled_jacobian);
+  sum_sj += q.scaled_jacobian;
+  p.min_angle_deg = std::min(p.min_angle_deg, q.min_angle_deg);
+  p.max_angle_deg = std::max(p.max_angle_deg, q.max_angle_deg);
+  p.max_aspect_ratio = std::max(p.max_aspect_ratio, q.aspect_ratio);
+  p.max_radius_ratio = std::max(p.max_radius_ratio, q.radius_ratio);
+  const int bin = std::clamp(static_cast<int>(std::floor((q.scaled_jacobian + 1.0) / 0.2)), 0, 9);
+  ++p.scaled_jacobian_histogram[bin];
+  if (q.min_angle_deg < sliver_threshold_deg) ++p.n_slivers;
+  p.measure += measure;
+}
+
+// summarize_quality's triangles and quads: every number of element_quality and signed_measure
+// as they compute it, with each edge vector and length computed once (a corner's two edges are
+// e[c] and -e[c - 1]: a vector and its negation have the same norm and products, bit for bit),
+// and the corner angles kept as their keys (polygon_corner_keys' cosines: the angle is
+// acos(key), non-increasing in it), so that acos is taken only where an extreme or the sliver
+// test needs it, as for the tetrahedra above.
+template <int n> struct PolygonTerms {
+  double key[n];
+  double key_lo, key_hi;  ///< extremes of the keys
+  double scaled_jacobian, aspect_ratio, measure;
+};
+template <int n> PolygonTerms<n> polygon_terms(ElemType t, std::span<const Point<2>> p) {
+  PolygonTerms<n> r;
+  Point<2> e[n];
+  double len[n];
+  double sum = 0.0, longest = 0.0;  // edge_length_range's, edge i = (i, i + 1)
+  for (int i = 0; i < n; ++i) {
+    e[i] = p[(i + 1) % n] - p[i];
+    len[i] = e[i].norm();
+    longest = std::max(longest, len[i]);
+    sum += len[i];
+  }
+  r.key_lo = inf, r.key_hi = -inf;
+  for (int c = 0; c < n; ++c) {  // corners(t): corner c between p[c + 1] and p[c - 1]
+    const int prev = (c + n - 1) % n;
+    const double na = len[c], nb = len[prev];
+    const double k = na == 0.0 || nb == 0.0 ? 1.0 : std::clamp(e[c].dot(-e[prev]) / (na * nb), -1.0, 1.0);
+    r.key[c] = k;
+    r.key_lo = std::min(r.key_lo, k), r.key_hi = std::max(r.key_hi, k);
+  }
+  r.scaled_jacobian = polygon_jacobians<n>(p.data(), normalisation(t)).second;
+  r.measure = signed_measure<2>(t, p);
+  const double denom = (n == 3 ? 4.0 * std::sqrt(3.0) : 4.0) * std::abs(r.measure);  // polygon_aspect_ratio
+  r.aspect_ratio = denom > 0.0 ? longest * sum / denom : inf;
+  return r;
+}
+
+/// The smallest (largest) corner angle of a polygon from its keys: acos of the keys within
+/// key_gap of the largest (smallest) key, the only ones that can give it.
+double min_corner_angle(const double* key, int n, double key_hi) {
+  double lo = inf;
+  for (int i = 0; i < n; ++i)
+    if (key[i] >= key_hi - key_gap) lo = std::min(lo, angle_of_key(key[i]));
+  return lo;
+}
+double max_corner_angle(const double* key, int n, double key_lo) {
+  double hi = -inf;
+  for (int i = 0; i < n; ++i)
+    if (key[i] <= key_lo + key_gap) hi = std::max(hi, angle_of_key(key[i]));
+  return hi;
+}
+
+/// Summary terms of the triangles and quads [begin, end) of a 2D mesh into p and sum_sj, as
+/// the generic loop adds them (an element with a key that is not finite goes that way).
+template <int Dim>
+void summarize_polygons(const Mesh<Dim>& mesh, std::size_t begin, std::size_t end, double sliver_threshold_deg,
+                        QualitySummary& p, double& sum_sj) {
+  if constexpr (Dim == 2) {
+    // Sliver test on the largest key: above key_sliver + 1e-7 the smallest angle is surely
+    // under the threshold, below key_sliver - 1e-7 surely not (1e-7 rad is far above acos's
+    // error); in between it is computed.
+    const double th = sliver_threshold_deg;
+    const bool by_key = th > 0.0 && th < 180.0;
+    const double key_sliver = by_key ? std::cos(th / rad_to_deg) : 0.0;
+    // Running extreme keys of the chunk: an element whose largest key is below the running
+    // largest - key_gap cannot hold the chunk's smallest angle (likewise for the largest).
+    double run_lo = inf, run_hi = -inf;
+    const auto add = [&](ElemType t, std::span<const Point<2>> ep, const auto& r) {
+      const int n = static_cast<int>(std::size(r.key));
+      if (!std::all_of(std::begin(r.key), std::end(r.key), [](double k) { return std::isfinite(k); })) {
+        add_element(element_quality<2>(t, ep), signed_measure<2>(t, ep), th, p, sum_sj);
+        return;
+      }
+      p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, r.scaled_jacobian);
+      sum_sj += r.scaled_jacobian;
+      double lo = std::numeric_limits<double>::quiet_NaN();  // NaN: not computed
+      if (r.key_hi >= run_hi - key_gap) {
+        lo = min_corner_angle(r.key, n, r.key_hi);
+        p.min_angle_deg = std::min(p.min_angle_deg, lo);
+        run_hi = std::max(run_hi, r.key_hi);
+      }
+      if (r.key_lo <= run_lo + key_gap) {
+        p.max_angle_deg = std::max(p.max_angle_deg, max_corner_angle(r.key, n, r.key_lo));
+        run_lo = std::min(run_lo, r.key_lo);
+      }
+      p.max_aspect_ratio = std::max(p.max_aspect_ratio, r.aspect_ratio);
+      p.max_radius_ratio = std::max(p.max_radius_ratio, ElementQuality{}.radius_ratio);
+      const int bin = std::clamp(static_cast<int>(std::floor((r.scaled_jacobian + 1.0) / 0.2)), 0, 9);
+      ++p.scaled_jacobian_histogram[bin];
+      bool sliver;
+      if (by_key && r.key_hi > key_sliver + 1e-7) {
+        sliver = true;
+      } else if (by_key && r.key_hi < key_sliver - 1e-7) {
+        sliver = false;
+      } else {
+        if (std::isnan(lo)) lo = min_corner_angle(r.key, n, r.key_hi);
+        sliver = lo < th;
+      }
+      if (sliver) ++p.n_slivers;
+      p.measure += r.measure;
+    };
+    for (std::size_t e = begin; e < end; ++e) {
+      const ElemType t = mesh.solid.type[e];
+      const auto ep = element_points<2>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
+      if (t == ElemType::Tri3) add(t, ep.span(), polygon_terms<3>(t, ep.span()));
+      else add(t, ep.span(), polygon_terms<4>(t, ep.span()));
+    }
+  } else {
+    (void)mesh, (void)begin, (void)end, (void)sliver_threshold_deg, (void)p, (void)sum_sj;
+    MESH_ASSERT(false, "polygons in a 3D mesh's solid");
+  }
+}
+
 }  // namespace
 
 template <int Dim>
@@ -612,20 +764,18 @@ QualitySummary summarize_quality(const Mesh<Dim>& mesh, double sliver_threshold_
         return;
       }
     }
+    if constexpr (Dim == 2) {
+      const bool all_polygons = std::all_of(mesh.solid.type.begin() + begin, mesh.solid.type.begin() + end,
+                                            [](ElemType t) { return t == ElemType::Tri3 || t == ElemType::Quad4; });
+      if (all_polygons) {
+        summarize_polygons<Dim>(mesh, begin, end, sliver_threshold_deg, p, parts[c].sum_sj);
+        return;
+      }
+    }
     for (std::size_t e = begin; e < end; ++e) {
       const ElemType t = mesh.solid.type[e];
       const auto ep = element_points<Dim>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
-      const ElementQuality q = element_quality<Dim>(t, ep.span());
-      p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, q.scaled_jacobian);
-      parts[c].sum_sj += q.scaled_jacobian;
-      p.min_angle_deg = std::min(p.min_angle_deg, q.min_angle_deg);
-      p.max_angle_deg = std::max(p.max_angle_deg, q.max_angle_deg);
-      p.max_aspect_ratio = std::max(p.max_aspect_ratio, q.aspect_ratio);
-      p.max_radius_ratio = std::max(p.max_radius_ratio, q.radius_ratio);
-      const int bin = std::clamp(static_cast<int>(std::floor((q.scaled_jacobian + 1.0) / 0.2)), 0, 9);
-      ++p.scaled_jacobian_histogram[bin];
-      if (q.min_angle_deg < sliver_threshold_deg) ++p.n_slivers;
-      p.measure += signed_measure<Dim>(t, ep.span());
+      add_element(element_quality<Dim>(t, ep.span()), signed_measure<Dim>(t, ep.span()), sliver_threshold_deg, p, parts[c].sum_sj);
     }
   });
   s.min_scaled_jacobian = inf;

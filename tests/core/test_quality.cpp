@@ -192,6 +192,70 @@ TEST_CASE("the tetrahedra's summary equals element_quality's, bit for bit", "[qu
   }
 }
 
+TEST_CASE("the triangles' and quads' summary equals element_quality's, bit for bit", "[quality]") {
+  // summarize_quality takes acos only near the extremes and the sliver threshold; element_quality
+  // takes it at every corner (the slow twin). Triangles, quads, both in one mesh; a quad with a
+  // zero edge (its corners there count 0 deg), and a node that is not a number (the element goes
+  // the generic way).
+  const auto check = [](Mesh<2> m) {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo, aspect = 0.0, sj_lo = 2.0, measure = 0.0;
+    std::vector<double> mins;
+    for (std::size_t e = 0; e < m.solid.size(); ++e) {
+      const auto ep = element_points<2>(m.solid, ElemId{static_cast<std::int32_t>(e)}, m.points);
+      const ElementQuality q = element_quality<2>(m.solid.type[e], ep.span());
+      lo = std::min(lo, q.min_angle_deg), hi = std::max(hi, q.max_angle_deg);
+      aspect = std::max(aspect, q.aspect_ratio), sj_lo = std::min(sj_lo, q.scaled_jacobian);
+      measure += signed_measure<2>(m.solid.type[e], ep.span());
+      mins.push_back(q.min_angle_deg);
+    }
+    std::sort(mins.begin(), mins.end());
+    // Thresholds at elements' own smallest angles (the strict "<" at its edge) and between.
+    for (const double th : {10.0, 40.0, mins[mins.size() / 3], mins[mins.size() / 2], std::nextafter(mins[7], 0.0), 179.0, 0.0}) {
+      const QualitySummary s = summarize_quality(m, th);
+      CAPTURE(m.solid.size(), th);
+      CHECK(s.min_angle_deg == lo);
+      CHECK(s.max_angle_deg == hi);
+      CHECK(s.max_aspect_ratio == aspect);
+      CHECK(s.min_scaled_jacobian == sj_lo);
+      CHECK(s.measure == measure);
+      CHECK(s.n_slivers == static_cast<std::size_t>(std::lower_bound(mins.begin(), mins.end(), th) - mins.begin()));
+    }
+  };
+  const auto wobble = [](Mesh<2> m) {
+    for (Point<2>& p : m.points) p += 0.2 * Point<2>(std::sin(7.0 * p.y()), std::cos(5.0 * p.x()));
+    return m;
+  };
+  check(wobble(test::grid_mesh<2>(40, true)));
+  check(wobble(test::grid_mesh<2>(40, false)));
+  Mesh<2> both = wobble(test::grid_mesh<2>(30, false));
+  Elements mixed;
+  for (std::size_t e = 0; e < both.solid.size(); ++e) {
+    const VertexId* v = both.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    if (e % 3 == 0) {
+      const std::array<VertexId, 3> a = {v[0], v[1], v[2]}, b = {v[0], v[2], v[3]};
+      mixed.add(ElemType::Tri3, a.data(), 3);
+      mixed.add(ElemType::Tri3, b.data(), 3);
+    } else {
+      mixed.add(ElemType::Quad4, v, 4);
+    }
+  }
+  both.solid = mixed;
+  both.level.clear();
+  both.from_boundary_cell.clear();
+  check(both);
+  Mesh<2> odd = both;
+  odd.points[odd.solid.node[odd.solid.offset[5] + 1].v] = odd.points[odd.solid.node[odd.solid.offset[5]].v];  // a zero edge
+  check(odd);
+  odd.points[odd.solid.node[odd.solid.offset[40]].v].x() = std::numeric_limits<double>::quiet_NaN();
+  const QualitySummary s = summarize_quality(odd, 30.0);
+  double lo = std::numeric_limits<double>::infinity();
+  for (std::size_t e = 0; e < odd.solid.size(); ++e) {
+    const auto ep = element_points<2>(odd.solid, ElemId{static_cast<std::int32_t>(e)}, odd.points);
+    lo = std::min(lo, element_quality<2>(odd.solid.type[e], ep.span()).min_angle_deg);
+  }
+  CHECK(s.min_angle_deg == lo);
+}
+
 TEST_CASE("a tetrahedron's min corner Jacobian is its four corners', bit for bit", "[quality]") {
   // The slow twin: each corner (c; a, b, d) of Gmsh's right-handed order, J = (a - c) . ((b - c) x (d - c)),
   // the minimum taken from infinity (a NaN corner is passed over).
