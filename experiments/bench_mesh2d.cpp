@@ -9,12 +9,15 @@
 //
 // Usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a.json,b.svg] [--no-gmsh] [--threads N]
 //                     [--memory-budget GB] [--gmsh-max N]
-//                     [--elements tri|quad|mixed]
+//                     [--elements tri|quad|mixed] [--pin-one-thread]
 //   --memory-budget: a size whose estimated peak (bytes/element of the previous size) exceeds
 //   it is skipped with a message (default 6 GB: the machine is shared).
 //   --gmsh-max: no Gmsh run above this many elements (default 1.2e6; Gmsh takes ~30 s per 10^6).
 //   --elements: tri (default), quad or mixed.
 //   --levels: run these levels instead of searching sizes for --sizes.
+//   --pin-one-thread: with --threads 1, each timed run on the CPU that reads memory fastest
+//   just before it (experiments/cpu_probe.hpp: on this VM the two vCPUs differ by up to 1.45x
+//   there, and which one is slow changes); every run prints and records that probe.
 // Output: tables on stdout, results/bench_mesh2d.md and results/bench_mesh2d.json.
 
 #include <algorithm>
@@ -27,6 +30,7 @@
 #include <sstream>
 
 #include "core/huge_page_heap.hpp"
+#include "experiments/cpu_probe.hpp"
 #include "experiments/scaling_runs.hpp"
 #include "experiments/size_search.hpp"
 
@@ -73,6 +77,7 @@ int main(int argc, char** argv) {
   int threads = 1;
   dim2::ElementKind elements = dim2::ElementKind::Tri;
   double budget = 6e9, gmsh_max = 1.2e6;
+  bool pin_one_thread = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -99,15 +104,20 @@ int main(int argc, char** argv) {
       budget = std::stod(next()) * 1e9;
     } else if (a == "--gmsh-max") {
       gmsh_max = std::stod(next());
+    } else if (a == "--pin-one-thread") {
+      pin_one_thread = true;
     } else {
       std::cerr << "usage: bench_mesh2d [--sizes 1e4,1e5,1e6] [--inputs a,b] [--no-gmsh] [--threads N] "
-                   "[--memory-budget GB] [--gmsh-max N] [--levels 8,9.4] [--elements tri|quad|mixed]\n";
+                   "[--memory-budget GB] [--gmsh-max N] [--levels 8,9.4] [--elements tri|quad|mixed] [--pin-one-thread]\n";
       return 2;
     }
   }
   const fs::path res = fs::path(src) / "results";
   const fs::path work = res / "bench_mesh2d";
   fs::create_directories(work);
+  // The CPUs' memory speed, before and after the runs (cpu_probe.hpp).
+  const std::vector<CpuMemoryProbe> probe_before = probe_cpu_memory();
+  std::cout << "machine: " << describe(probe_before) << "\n" << std::flush;
 
   nlohmann::json jruns = nlohmann::json::array();
   std::ostringstream table, stages_table, skipped;
@@ -156,7 +166,11 @@ int main(int argc, char** argv) {
                   << std::int64_t(aim.count) << " elements)\n"
                   << std::flush;
       }
-      const OurRun run = run_ours_2d(*base, level, threads, work / name, elements, size);
+      // --pin-one-thread: on the CPU that reads memory fastest just before the run.
+      const OurRun run = [&] {
+        const PinnedTo pin(pin_one_thread && threads == 1 ? fastest_cpu(probe_cpu_memory()) : -1);
+        return run_ours_2d(*base, level, threads, work / name, elements, size);
+      }();
       if (!run.ok) {
         std::cout << "  " << tag << ": febemesh failed: " << run.error << "\n";
         skipped << "- " << tag << ": febemesh failed: " << run.error << "\n";
@@ -200,9 +214,13 @@ int main(int argc, char** argv) {
   }
 
   stages_table << stage_table(all);
+  const std::vector<CpuMemoryProbe> probe_after = probe_cpu_memory();
+  std::cout << "machine: " << describe(probe_after) << "\n";
 
   std::ostringstream md;
   md << "# bench_mesh2d: febemesh vs Gmsh, end to end\n\n"
+     << "Machine: before the runs " << describe(probe_before) << "; after them " << describe(probe_after)
+     << (pin_one_thread && threads == 1 ? "; our runs pinned to the faster CPU of a probe just before each" : "") << ".\n\n"
      << "Ours: mesh2d from the parsed input to a written mesh.msh (ASCII), " << threads
      << " thread(s), in process; peak = growth of the peak RSS over the run. Gmsh: `gmsh -2 -nt 1` on the same exact "
         "curves, uniform size rescaled to our element count (+-20%), whole process (reading the .geo, writing the "
@@ -211,7 +229,17 @@ int main(int argc, char** argv) {
      << table.str() << "\n## Stage times (seconds, wall)\n\n" << stages_table.str();
   if (!skipped.str().empty()) md << "\n## Skipped\n\n" << skipped.str();
   std::ofstream(res / "bench_mesh2d.md") << md.str();
-  std::ofstream(res / "bench_mesh2d.json") << nlohmann::json{{"runs", jruns}}.dump(2) << "\n";
+  const auto probe_json = [](const std::vector<CpuMemoryProbe>& p) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const CpuMemoryProbe& c : p) j.push_back({{"cpu", c.cpu}, {"ns_per_read", c.ns_per_read}});
+    return j;
+  };
+  std::ofstream(res / "bench_mesh2d.json") << nlohmann::json{{"runs", jruns},
+                                                             {"cpu_memory_before", probe_json(probe_before)},
+                                                             {"cpu_memory_after", probe_json(probe_after)},
+                                                             {"pin_one_thread", pin_one_thread && threads == 1}}
+                                                  .dump(2)
+                                           << "\n";
   std::cout << "\n" << stages_table.str() << "\nwrote " << (res / "bench_mesh2d.md").string() << "\n";
   return 0;
 }

@@ -10,6 +10,10 @@
 //
 // Usage: bench_mesh3d [--levels 3,4,5 | --tets 1e4,1e5,1e6,5e6] [--inputs a.off,b.off | --all-surfaces]
 //                     [--no-tetgen] [--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]
+//                     [--pin-one-thread]
+// --pin-one-thread: each one-thread run on the CPU that reads memory fastest just before it
+// (experiments/cpu_probe.hpp: on this VM the two vCPUs differ by up to 1.45x there, and which
+// one is slow changes); every run prints and records that probe, before and after the runs.
 // --target-dihedral: the CLI's option of that name (the optimisation's aim, default 30). Both
 // tools' smallest dihedral angles are in the table (measured after the timed runs).
 // The default input is sphere966 (no repairs: the stages' own speed); --all-surfaces takes every
@@ -31,6 +35,7 @@
 #include <sstream>
 
 #include "core/huge_page_heap.hpp"
+#include "experiments/cpu_probe.hpp"
 #include "experiments/scaling_runs.hpp"
 #include "experiments/size_search.hpp"
 
@@ -80,6 +85,7 @@ int main(int argc, char** argv) {
   int repeat = 1;
   double budget = 6e9;
   double target_deg = dim3::Options3d{}.target_dihedral_deg;
+  bool pin_one_thread = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&]() -> std::string {
@@ -113,15 +119,21 @@ int main(int argc, char** argv) {
       budget = std::stod(next()) * 1e9;
     } else if (a == "--target-dihedral") {
       target_deg = std::clamp(std::stod(next()), 0.0, 35.0);
+    } else if (a == "--pin-one-thread") {
+      pin_one_thread = true;
     } else {
       std::cerr << "usage: bench_mesh3d [--levels 3,4,5 | --tets 1e4,1e5] [--inputs a.off,b.off | --all-surfaces] [--no-tetgen] "
-                   "[--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG]\n";
+                   "[--threads 1,2] [--repeat R] [--memory-budget GB] [--target-dihedral DEG] [--pin-one-thread]\n";
       return 2;
     }
   }
   const fs::path res = fs::path(src) / "results";
   const fs::path work = res / "bench_mesh3d";
   fs::create_directories(work);
+  // The CPUs' memory speed, before and after the runs (cpu_probe.hpp: on this VM one vCPU
+  // reads memory up to 1.45x slower than the other, and which one changes).
+  const std::vector<CpuMemoryProbe> probe_before = probe_cpu_memory();
+  std::cout << "machine: " << describe(probe_before) << "\n" << std::flush;
 
   nlohmann::json jruns = nlohmann::json::array(), jthreads = nlohmann::json::array();
   std::ostringstream table, stages_table, skipped;
@@ -184,6 +196,8 @@ int main(int argc, char** argv) {
       for (int r = 0; r < repeat; ++r)
         for (std::size_t k = 0; k < thread_counts.size(); ++k) {
           const fs::path dir = thread_counts.size() > 1 ? work / name / ("threads" + std::to_string(thread_counts[k])) : work / name;
+          // --pin-one-thread: on the CPU that reads memory fastest just before the run.
+          const PinnedTo pin(pin_one_thread && thread_counts[k] == 1 ? fastest_cpu(probe_cpu_memory()) : -1);
           OurRun one = run_ours_3d(input, level, thread_counts[k], dir, target_deg, size);
           if (!one.ok || !best[k].ok || one.wall_seconds < best[k].wall_seconds) best[k] = std::move(one);
         }
@@ -254,9 +268,13 @@ int main(int argc, char** argv) {
   }
 
   stages_table << stage_table(all);
+  const std::vector<CpuMemoryProbe> probe_after = probe_cpu_memory();
+  std::cout << "machine: " << describe(probe_after) << "\n";
 
   std::ostringstream md;
   md << "# bench_mesh3d: febemesh vs TetGen, end to end\n\n"
+     << "Machine: before the runs " << describe(probe_before) << "; after them " << describe(probe_after)
+     << (pin_one_thread ? "; one-thread runs pinned to the faster CPU of a probe just before each" : "") << ".\n\n"
      << "Ours: mesh3d from reading the surface to a written mesh.msh (ASCII), " << threads
      << " thread(s), in process, the optimisation aiming at " << fixed(target_deg, 1)
      << " deg (--target-dihedral); peak = growth of the peak RSS over the run. TetGen: libtet `-pq1.414/10a<vol>Q` in a "
@@ -270,7 +288,18 @@ int main(int argc, char** argv) {
        << threads_table.str() << "\n" << stage_table(all_threads);
   if (!skipped.str().empty()) md << "\n## Skipped or failed\n\n" << skipped.str();
   std::ofstream(res / "bench_mesh3d.md") << md.str();
-  std::ofstream(res / "bench_mesh3d.json") << nlohmann::json{{"runs", jruns}, {"threads", jthreads}}.dump(2) << "\n";
+  const auto probe_json = [](const std::vector<CpuMemoryProbe>& p) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const CpuMemoryProbe& c : p) j.push_back({{"cpu", c.cpu}, {"ns_per_read", c.ns_per_read}});
+    return j;
+  };
+  std::ofstream(res / "bench_mesh3d.json") << nlohmann::json{{"runs", jruns},
+                                                             {"threads", jthreads},
+                                                             {"cpu_memory_before", probe_json(probe_before)},
+                                                             {"cpu_memory_after", probe_json(probe_after)},
+                                                             {"pin_one_thread", pin_one_thread}}
+                                                  .dump(2)
+                                           << "\n";
   std::cout << "\n" << stages_table.str();
   if (thread_counts.size() > 1) std::cout << "\n" << threads_table.str() << "\n" << stage_table(all_threads);
   std::cout << "\nwrote " << (res / "bench_mesh3d.md").string() << "\n";
