@@ -1,11 +1,11 @@
 #pragma once
 // How fast each CPU reads memory, for the benchmarks (issue 8). On this VM (2 vCPUs) random
-// reads from a 64 MiB array take 1.35-1.45x as long on one vCPU as on the other, and which one
+// reads from a 64 MiB array took up to 1.43x as long on one vCPU as on the other, and which one
 // is slow changes over minutes (session 45: cpu1 0.30 s against cpu0 0.22 s, later cpu0 0.30 s
-// against cpu1 0.21 s), while arithmetic runs at the same speed on both. A one-thread run is
-// then 1.3-1.4x slower on the slow vCPU (bench_mesh3d sphere966 at 10^6 tets pinned: 2.89 s
-// against 3.76-4.02 s), and a two-thread run whose work is split in equal halves waits for the
-// slow one. So every bench prints this probe beside its times, and --pin-one-thread runs the
+// against cpu1 0.21 s, later still 1.02-1.22x apart), while arithmetic runs at the same speed on
+// both. A one-thread run was then up to 1.3-1.5x slower on the slow vCPU (bench_mesh3d
+// sphere966 at 10^6 tets pinned: 2.89 s against 3.76-4.02 s; bench_mesh2d flange 0.54 against
+// 0.83 s), and a two-thread run whose work is split in equal halves waits for the slow one. So every bench prints this probe beside its times, and --pin-one-thread runs the
 // one-thread timings on the vCPU that is fast at that moment (the baseline of a speedup then
 // being the better one-thread time).
 
