@@ -319,10 +319,9 @@ class FacetGroups {
   /// the solid's distinct edges as unique_edges gives them.
   bool polygons() const { return polygons_; }
 
-  /// The groups in chunks of consecutive keys: chunk c holds the groups [group_start(c),
-  /// group_start(c + 1)) of the key order.
+  /// The groups come in chunks of consecutive keys (for_each's c): bucketed, chunk c holds the
+  /// buckets [c, c + 1) * chunk_buckets; otherwise there is one chunk.
   std::size_t n_chunks() const { return chunk_groups_.empty() ? 1 : chunk_groups_.size() - 1; }
-  std::size_t group_start(std::size_t c) const { return chunk_groups_.empty() ? (c == 0 ? 0 : n_groups_) : chunk_groups_[c]; }
 
   /// Calls group(c, i, std::span<const FacetUse>) for every distinct key, i its index in key
   /// order and c its chunk: the chunks on n_threads threads, each chunk's groups in key order on
