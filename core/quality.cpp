@@ -224,11 +224,18 @@ std::array<double, 4> tet_corner_dets(std::span<const Point<3>> p) {
 /// jacobians() of a tetrahedron: the corners of tet_corners in their order, with the same
 /// numbers, but each of the six edge lengths computed once (|p - q| and |q - p| are the same
 /// bits), not once per corner that uses it (the smoothing guard's hot path).
-std::pair<double, double> tet_jacobians(std::span<const Point<3>> p) {
+/// `longest`, when given: the longest edge, as edge_length_range's maximum (a vector and its
+/// negation have the same norm, and a maximum does not depend on the order).
+std::pair<double, double> tet_jacobians(std::span<const Point<3>> p, double* longest = nullptr) {
   const Point<3> e01 = p[1] - p[0], e02 = p[2] - p[0], e03 = p[3] - p[0], e12 = p[2] - p[1], e13 = p[3] - p[1],
                  e23 = p[3] - p[2];
   const double l01 = e01.norm(), l02 = e02.norm(), l03 = e03.norm(), l12 = e12.norm(), l13 = e13.norm(),
                l23 = e23.norm();
+  if (longest) {
+    double hi = 0.0;  // (std::max(hi, NaN) keeps hi, as there)
+    for (const double l : {l01, l12, l02, l03, l23, l13}) hi = std::max(hi, l);
+    *longest = hi;
+  }
   // tet_corner_dets written out (a call there cost the smoothing guard 38 M instructions at
   // sphere966 level 5); lengths |a - c| |b - c| |d - c| per corner.
   const double j[4] = {det3<3>(e01, e02, e03), det3<3>(e12, Point<3>(p[0] - p[1]), e13),
@@ -498,13 +505,8 @@ const std::array<std::array<int, 2>, 6>& tet_edge_facets() {
 TetTerms tet_terms(std::span<const Point<3>> p) {
   constexpr ElemType t = ElemType::Tet4;
   TetTerms r;
-  r.scaled_jacobian = tet_jacobians(p).second;
-  // Longest edge: edge_length_range's maximum (the order of a maximum does not matter).
-  double longest = 0.0;
-  for (int e = 0; e < 6; ++e) {
-    const auto [a, b] = edge_local_nodes(t, e);
-    longest = std::max(longest, (p[b] - p[a]).norm());
-  }
+  double longest = 0.0;  // edge_length_range's maximum, from the edge lengths tet_jacobians takes
+  r.scaled_jacobian = tet_jacobians(p, &longest).second;
   Point<3> normal[4];
   double normal_len[4];
   double area = 0.0;
