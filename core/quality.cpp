@@ -545,63 +545,82 @@ TetTerms tet_terms(std::span<const Point<3>> p) {
   return r;
 }
 
-/// dihedral_range's minimum (maximum): over the keys within key_gap of the smallest (largest).
-double min_dihedral(const TetTerms& r) {
-  double lo = inf;
-  for (const double k : r.key)
-    if (k <= r.key_lo + key_gap) lo = std::min(lo, dihedral_of_key(k));
-  return lo;
-}
-double max_dihedral(const TetTerms& r) {
-  double hi = -inf;
-  for (const double k : r.key)
-    if (k >= r.key_hi - key_gap) hi = std::max(hi, dihedral_of_key(k));
-  return hi;
-}
+/// A chunk's smallest and largest angle and its sliver count from its elements' angle keys,
+/// angle_of(key) non-decreasing in the key (the tetrahedra's dihedral keys; the polygons' corner
+/// cosines negated): an element's extreme angle comes from the keys within key_gap of its extreme
+/// key, and an element whose extreme key is farther than key_gap beyond the chunk's running one
+/// cannot hold the chunk's extreme, so acos is taken only there and near the sliver threshold.
+/// NaN keys are passed over.
+template <class AngleOf> class KeyedAngles {
+ public:
+  /// Slivers: elements whose smallest angle is under threshold_deg; key_sliver is the key of
+  /// that angle (used when by_key: 0 < threshold < 180).
+  KeyedAngles(AngleOf angle_of, double threshold_deg, double key_sliver)
+      : angle_of_(angle_of), threshold_(threshold_deg), by_key_(threshold_deg > 0.0 && threshold_deg < 180.0),
+        key_sliver_(key_sliver) {}
+
+  /// An element's n keys, key_lo and key_hi their extremes over the non-NaN ones (inf, -inf
+  /// without any): its terms of p's smallest and largest angle and of its sliver count.
+  void add(const double* key, int n, double key_lo, double key_hi, QualitySummary& p) {
+    double lo = std::numeric_limits<double>::quiet_NaN();  // NaN: not computed
+    if (key_lo <= run_lo_ + key_gap) {
+      lo = smallest(key, n, key_lo);
+      p.min_angle_deg = std::min(p.min_angle_deg, lo);
+      run_lo_ = std::min(run_lo_, key_lo);
+    }
+    if (key_hi >= run_hi_ - key_gap) {
+      double hi = -inf;
+      for (int i = 0; i < n; ++i)
+        if (key[i] >= key_hi - key_gap) hi = std::max(hi, angle_of_(key[i]));
+      p.max_angle_deg = std::max(p.max_angle_deg, hi);
+      run_hi_ = std::max(run_hi_, key_hi);
+    }
+    // Below key_sliver - 1e-7 the smallest angle is surely under the threshold, above
+    // key_sliver + 1e-7 surely not (1e-7 rad is far above acos's error); in between it is computed.
+    bool sliver;
+    if (by_key_ && key_lo < key_sliver_ - 1e-7) {
+      sliver = true;
+    } else if (by_key_ && key_lo > key_sliver_ + 1e-7) {
+      sliver = false;
+    } else {
+      if (std::isnan(lo)) lo = smallest(key, n, key_lo);
+      sliver = lo < threshold_;
+    }
+    if (sliver) ++p.n_slivers;
+  }
+
+ private:
+  double smallest(const double* key, int n, double key_lo) const {
+    double lo = inf;
+    for (int i = 0; i < n; ++i)
+      if (key[i] <= key_lo + key_gap) lo = std::min(lo, angle_of_(key[i]));
+    return lo;
+  }
+
+  AngleOf angle_of_;
+  double threshold_;
+  bool by_key_;
+  double key_sliver_;
+  double run_lo_ = inf, run_hi_ = -inf;  ///< the chunk's running extreme keys
+};
 
 /// Summary terms of tetrahedra [begin, end) into p and sum_sj, as the generic loop adds them.
 template <int Dim>
 void summarize_tets(const Mesh<Dim>& mesh, std::size_t begin, std::size_t end, double sliver_threshold_deg,
                     QualitySummary& p, double& sum_sj) {
   if constexpr (Dim == 3) {
-    // Sliver test on the smallest key: below key_sliver - 1e-7 the min dihedral is surely under
-    // the threshold, above key_sliver + 1e-7 surely not (1e-7 rad is far above acos's error);
-    // in between it is computed.
     const double th = sliver_threshold_deg;
-    const bool by_key = th > 0.0 && th < 180.0;
-    const double key_sliver = by_key ? std::cos((180.0 - th) / rad_to_deg) : 0.0;
-    // Running extreme keys of the chunk: an element whose smallest key is above the running
-    // smallest + key_gap cannot hold the chunk's min dihedral (likewise for the max).
-    double run_lo = inf, run_hi = -inf;
+    KeyedAngles angles(dihedral_of_key, th, th > 0.0 && th < 180.0 ? std::cos((180.0 - th) / rad_to_deg) : 0.0);
     for (std::size_t e = begin; e < end; ++e) {
       const auto ep = element_points<3>(mesh.solid, ElemId{static_cast<std::int32_t>(e)}, mesh.points);
       const TetTerms r = tet_terms(ep.span());
       p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, r.scaled_jacobian);
       sum_sj += r.scaled_jacobian;
-      double lo = std::numeric_limits<double>::quiet_NaN();  // NaN: not computed
-      if (r.key_lo <= run_lo + key_gap) {
-        lo = min_dihedral(r);
-        p.min_angle_deg = std::min(p.min_angle_deg, lo);
-        run_lo = std::min(run_lo, r.key_lo);
-      }
-      if (r.key_hi >= run_hi - key_gap) {
-        p.max_angle_deg = std::max(p.max_angle_deg, max_dihedral(r));
-        run_hi = std::max(run_hi, r.key_hi);
-      }
+      angles.add(r.key.data(), 6, r.key_lo, r.key_hi, p);
       p.max_aspect_ratio = std::max(p.max_aspect_ratio, r.aspect_ratio);
       p.max_radius_ratio = std::max(p.max_radius_ratio, r.radius_ratio);
       const int bin = std::clamp(static_cast<int>(std::floor((r.scaled_jacobian + 1.0) / 0.2)), 0, 9);
       ++p.scaled_jacobian_histogram[bin];
-      bool sliver;
-      if (by_key && r.key_lo < key_sliver - 1e-7) {
-        sliver = true;
-      } else if (by_key && r.key_lo > key_sliver + 1e-7) {
-        sliver = false;
-      } else {
-        if (std::isnan(lo)) lo = min_dihedral(r);
-        sliver = lo < sliver_threshold_deg;
-      }
-      if (sliver) ++p.n_slivers;
       p.measure += r.measure;
     }
   } else {
@@ -627,11 +646,11 @@ void add_element(const ElementQuality& q, double measure, double sliver_threshol
 // summarize_quality's triangles and quads: every number of element_quality and signed_measure
 // as they compute it, with each edge vector and length computed once (a corner's two edges are
 // e[c] and -e[c - 1]: a vector and its negation have the same norm and products, bit for bit),
-// and the corner angles kept as their keys (polygon_corner_keys' cosines: the angle is
-// acos(key), non-increasing in it), so that acos is taken only where an extreme or the sliver
-// test needs it, as for the tetrahedra above.
+// and the corner angles kept as keys for KeyedAngles, as for the tetrahedra above: the cosines
+// polygon_corner_keys takes, negated (the angle, angle_of_key(-key), rises with the key; a
+// negation is exact, and so are the comparisons of negated numbers).
 template <int n> struct PolygonTerms {
-  double key[n];
+  double key[n];          ///< -cos of each corner angle, in corners(t)'s order
   double key_lo, key_hi;  ///< extremes of the keys
   double scaled_jacobian, aspect_ratio, measure;
 };
@@ -650,7 +669,7 @@ template <int n> PolygonTerms<n> polygon_terms(ElemType t, std::span<const Point
   for (int c = 0; c < n; ++c) {  // corners(t): corner c between p[c + 1] and p[c - 1]
     const int prev = (c + n - 1) % n;
     const double na = len[c], nb = len[prev];
-    const double k = na == 0.0 || nb == 0.0 ? 1.0 : std::clamp(e[c].dot(-e[prev]) / (na * nb), -1.0, 1.0);
+    const double k = -(na == 0.0 || nb == 0.0 ? 1.0 : std::clamp(e[c].dot(-e[prev]) / (na * nb), -1.0, 1.0));
     r.key[c] = k;
     r.key_lo = std::min(r.key_lo, k), r.key_hi = std::max(r.key_hi, k);
   }
@@ -661,68 +680,27 @@ template <int n> PolygonTerms<n> polygon_terms(ElemType t, std::span<const Point
   return r;
 }
 
-/// The smallest (largest) corner angle of a polygon from its keys: acos of the keys within
-/// key_gap of the largest (smallest) key, the only ones that can give it.
-double min_corner_angle(const double* key, int n, double key_hi) {
-  double lo = inf;
-  for (int i = 0; i < n; ++i)
-    if (key[i] >= key_hi - key_gap) lo = std::min(lo, angle_of_key(key[i]));
-  return lo;
-}
-double max_corner_angle(const double* key, int n, double key_lo) {
-  double hi = -inf;
-  for (int i = 0; i < n; ++i)
-    if (key[i] <= key_lo + key_gap) hi = std::max(hi, angle_of_key(key[i]));
-  return hi;
-}
-
 /// Summary terms of the triangles and quads [begin, end) of a 2D mesh into p and sum_sj, as
 /// the generic loop adds them (an element with a key that is not finite goes that way).
 template <int Dim>
 void summarize_polygons(const Mesh<Dim>& mesh, std::size_t begin, std::size_t end, double sliver_threshold_deg,
                         QualitySummary& p, double& sum_sj) {
   if constexpr (Dim == 2) {
-    // Sliver test on the largest key: above key_sliver + 1e-7 the smallest angle is surely
-    // under the threshold, below key_sliver - 1e-7 surely not (1e-7 rad is far above acos's
-    // error); in between it is computed.
     const double th = sliver_threshold_deg;
-    const bool by_key = th > 0.0 && th < 180.0;
-    const double key_sliver = by_key ? std::cos(th / rad_to_deg) : 0.0;
-    // Running extreme keys of the chunk: an element whose largest key is below the running
-    // largest - key_gap cannot hold the chunk's smallest angle (likewise for the largest).
-    double run_lo = inf, run_hi = -inf;
+    KeyedAngles angles([](double key) { return angle_of_key(-key); }, th,
+                       th > 0.0 && th < 180.0 ? -std::cos(th / rad_to_deg) : 0.0);
     const auto add = [&](ElemType t, std::span<const Point<2>> ep, const auto& r) {
-      const int n = static_cast<int>(std::size(r.key));
       if (!std::all_of(std::begin(r.key), std::end(r.key), [](double k) { return std::isfinite(k); })) {
         add_element(element_quality<2>(t, ep), signed_measure<2>(t, ep), th, p, sum_sj);
         return;
       }
       p.min_scaled_jacobian = std::min(p.min_scaled_jacobian, r.scaled_jacobian);
       sum_sj += r.scaled_jacobian;
-      double lo = std::numeric_limits<double>::quiet_NaN();  // NaN: not computed
-      if (r.key_hi >= run_hi - key_gap) {
-        lo = min_corner_angle(r.key, n, r.key_hi);
-        p.min_angle_deg = std::min(p.min_angle_deg, lo);
-        run_hi = std::max(run_hi, r.key_hi);
-      }
-      if (r.key_lo <= run_lo + key_gap) {
-        p.max_angle_deg = std::max(p.max_angle_deg, max_corner_angle(r.key, n, r.key_lo));
-        run_lo = std::min(run_lo, r.key_lo);
-      }
+      angles.add(r.key, static_cast<int>(std::size(r.key)), r.key_lo, r.key_hi, p);
       p.max_aspect_ratio = std::max(p.max_aspect_ratio, r.aspect_ratio);
       p.max_radius_ratio = std::max(p.max_radius_ratio, ElementQuality{}.radius_ratio);
       const int bin = std::clamp(static_cast<int>(std::floor((r.scaled_jacobian + 1.0) / 0.2)), 0, 9);
       ++p.scaled_jacobian_histogram[bin];
-      bool sliver;
-      if (by_key && r.key_hi > key_sliver + 1e-7) {
-        sliver = true;
-      } else if (by_key && r.key_hi < key_sliver - 1e-7) {
-        sliver = false;
-      } else {
-        if (std::isnan(lo)) lo = min_corner_angle(r.key, n, r.key_hi);
-        sliver = lo < th;
-      }
-      if (sliver) ++p.n_slivers;
       p.measure += r.measure;
     };
     for (std::size_t e = begin; e < end; ++e) {
