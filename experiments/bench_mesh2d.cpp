@@ -229,11 +229,6 @@ int main(int argc, char** argv) {
      << table.str() << "\n## Stage times (seconds, wall)\n\n" << stages_table.str();
   if (!skipped.str().empty()) md << "\n## Skipped\n\n" << skipped.str();
   std::ofstream(res / "bench_mesh2d.md") << md.str();
-  const auto probe_json = [](const std::vector<CpuMemoryProbe>& p) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const CpuMemoryProbe& c : p) j.push_back({{"cpu", c.cpu}, {"ns_per_read", c.ns_per_read}});
-    return j;
-  };
   std::ofstream(res / "bench_mesh2d.json") << nlohmann::json{{"runs", jruns},
                                                              {"cpu_memory_before", probe_json(probe_before)},
                                                              {"cpu_memory_after", probe_json(probe_after)},

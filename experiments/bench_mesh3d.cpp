@@ -288,11 +288,6 @@ int main(int argc, char** argv) {
        << threads_table.str() << "\n" << stage_table(all_threads);
   if (!skipped.str().empty()) md << "\n## Skipped or failed\n\n" << skipped.str();
   std::ofstream(res / "bench_mesh3d.md") << md.str();
-  const auto probe_json = [](const std::vector<CpuMemoryProbe>& p) {
-    nlohmann::json j = nlohmann::json::array();
-    for (const CpuMemoryProbe& c : p) j.push_back({{"cpu", c.cpu}, {"ns_per_read", c.ns_per_read}});
-    return j;
-  };
   std::ofstream(res / "bench_mesh3d.json") << nlohmann::json{{"runs", jruns},
                                                              {"threads", jthreads},
                                                              {"cpu_memory_before", probe_json(probe_before)},

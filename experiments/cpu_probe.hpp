@@ -20,6 +20,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace febemesh::bench {
 
 struct CpuMemoryProbe {
@@ -90,6 +92,13 @@ inline std::vector<CpuMemoryProbe> probe_cpu_memory(std::size_t reads = 10'000'0
 inline int fastest_cpu(const std::vector<CpuMemoryProbe>& p) {
   const auto it = std::min_element(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.ns_per_read < b.ns_per_read; });
   return it == p.end() ? -1 : it->cpu;
+}
+
+/// The probe for a bench's .json: [{"cpu": 0, "ns_per_read": 92.1}, ...].
+inline nlohmann::json probe_json(const std::vector<CpuMemoryProbe>& p) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const CpuMemoryProbe& c : p) j.push_back({{"cpu", c.cpu}, {"ns_per_read", c.ns_per_read}});
+  return j;
 }
 
 /// "cpu0 92.1 ns, cpu1 128.3 ns a random read from 64 MiB (slowest / fastest 1.39x)".
