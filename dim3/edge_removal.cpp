@@ -7,6 +7,7 @@
 #include <limits>
 #include <queue>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include "core/error.hpp"
@@ -27,6 +28,43 @@ constexpr double none = -std::numeric_limits<double>::infinity();
 
 double orient(const P3& a, const P3& b, const P3& c, const P3& d) { return (b - a).dot((c - a).cross(d - a)); }
 
+/// A list of ids per node that only the nodes with entries pay for: a slot a node (4 B) and a
+/// vector for each node that ever had an entry. (A vector a node, 24 B each however few have
+/// entries, was 8.3 MB for the tetrahedra added and the interface triangles at sphere966's
+/// 995,232 tetrahedra, at edge removal's heap peak; massif.)
+class NodeLists {
+ public:
+  void reset(std::size_t n_nodes) {
+    slot_.assign(n_nodes, -1);
+    lists_.clear();
+  }
+  std::size_t n_nodes() const { return slot_.size(); }
+  /// Node v's entries, in the order they were added.
+  std::span<const std::int32_t> operator[](std::int32_t v) const {
+    const std::int32_t k = slot_[static_cast<std::size_t>(v)];
+    if (k < 0) return {};
+    return lists_[static_cast<std::size_t>(k)];
+  }
+  void push(std::int32_t v, std::int32_t id) { list(v).push_back(id); }
+  /// Removes the first entry `id` of node v's list (it must be there).
+  void erase(std::int32_t v, std::int32_t id) {
+    std::vector<std::int32_t>& l = list(v);
+    l.erase(std::find(l.begin(), l.end(), id));
+  }
+
+ private:
+  std::vector<std::int32_t>& list(std::int32_t v) {
+    std::int32_t& k = slot_[static_cast<std::size_t>(v)];
+    if (k < 0) {
+      k = static_cast<std::int32_t>(lists_.size());
+      lists_.emplace_back();
+    }
+    return lists_[static_cast<std::size_t>(k)];
+  }
+  std::vector<std::int32_t> slot_;
+  std::vector<std::vector<std::int32_t>> lists_;
+};
+
 /// The mesh as removals edit it. The input's tetrahedra are read from the mesh where they are;
 /// those added live here; dead ones of either stay until the write-back, which compacts the
 /// mesh's arrays in place (sphere966 L6: a full copy of the tetrahedra, their qualities and
@@ -45,10 +83,10 @@ struct Work {
   // as CSR (ascending), then those added, in order. The same sequence as lists with the dead
   // erased; the lists of vectors were 60 MB of sphere966 L6's 112 MB for edge removal.
   std::vector<std::int32_t> at_start, at_list;
-  std::vector<std::vector<std::int32_t>> at_added;
+  NodeLists at_added;
   std::vector<Tri> faces;
   std::vector<std::uint8_t> face_alive;
-  std::vector<std::vector<std::int32_t>> node_faces;
+  NodeLists node_faces;
   std::vector<std::uint8_t> node_dead;  ///< per node: contracted away
 
   Tet tet(std::int32_t t) const {
@@ -102,7 +140,7 @@ struct Work {
     added_q.push_back(quality(t));
     like.push_back(from >= n_input ? like[from - n_input] : from);
     alive.push_back(1);
-    for (const std::int32_t v : t) at_added[v].push_back(id);
+    for (const std::int32_t v : t) at_added.push(v, id);
     return id;
   }
   void kill_tet(std::int32_t t) { alive[t] = 0; }
@@ -111,14 +149,11 @@ struct Work {
     for (int e = 0; e < 3; ++e) longest_edge = std::max(longest_edge, (mesh.points[f[e]] - mesh.points[f[(e + 1) % 3]]).norm());
     faces.push_back(f);
     face_alive.push_back(1);
-    for (const std::int32_t v : f) node_faces[v].push_back(id);
+    for (const std::int32_t v : f) node_faces.push(v, id);
   }
   void kill_face(std::int32_t f) {
     face_alive[f] = 0;
-    for (const std::int32_t v : faces[f]) {
-      auto& l = node_faces[v];
-      l.erase(std::find(l.begin(), l.end(), f));
-    }
+    for (const std::int32_t v : faces[f]) node_faces.erase(v, f);
   }
 
   bool on_surface(std::int32_t v) const { return static_cast<std::size_t>(v) < where.size() && where[v].patch >= 0; }
@@ -189,8 +224,8 @@ struct Work {
   bool clear_outside(std::int32_t a, std::int32_t b, std::int32_t front, std::int32_t back, const std::vector<std::int32_t>& skip) {
     if (!grid) {
       std::vector<std::int32_t> interface_nodes;
-      for (std::size_t v = 0; v < node_faces.size(); ++v)
-        if (!node_faces[v].empty()) interface_nodes.push_back(static_cast<std::int32_t>(v));
+      for (std::size_t v = 0; v < node_faces.n_nodes(); ++v)
+        if (!node_faces[static_cast<std::int32_t>(v)].empty()) interface_nodes.push_back(static_cast<std::int32_t>(v));
       grid.emplace(mesh.points, interface_nodes);
     }
     const P3* p = mesh.points.data();
@@ -258,7 +293,7 @@ struct Work {
     });
     if (!ok || moved.size() == at_u.size() || !(new_min > old_min + opt.contract_min_gain_deg * pi / 180.0)) return false;
     // u's interface triangles: the two at uv go (a surface edge), the others take v.
-    const std::vector<std::int32_t> faces_u = node_faces[u];
+    const std::vector<std::int32_t> faces_u(node_faces[u].begin(), node_faces[u].end());
     std::vector<Tri> moved_faces;
     if (surface) {
       int at_uv = 0;
@@ -505,8 +540,8 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
         for (const std::int32_t u : w.tet(static_cast<std::int32_t>(e))) f(u);
       },
       opt.n_threads, w.at_start, w.at_list);
-  w.at_added.resize(n);
-  w.node_faces.resize(n);
+  w.at_added.reset(n);
+  w.node_faces.reset(n);
   w.node_dead.assign(n, 0);
   const double contract_below = opt.contract_below_deg * pi / 180.0;
   const double concave_below = opt.concave_below_deg * pi / 180.0;
@@ -551,7 +586,7 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   // The lists are done with: free them before the element arrays grow.
   std::vector<std::int32_t>().swap(w.at_list);
   std::vector<std::int32_t>().swap(w.at_start);
-  std::vector<std::vector<std::int32_t>>().swap(w.at_added);
+  w.at_added = {};
   std::vector<double>().swap(w.added_q);
   if (cell && !cell->empty()) {
     for (std::int32_t t = 0; t < w.n_tets(); ++t)
