@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "dim2/domain_checks.hpp"
 #include "dim2/read_domain.hpp"
 #include "dim2/svg_path.hpp"
 #include "dim2/xml_lite.hpp"
@@ -245,6 +246,48 @@ class SvgReader {
     TextPos pos;
   };
 
+  /// A point of the mesh's coordinates in the drawing's user units (y down), for messages.
+  static std::string user_coords(const P2& p) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "(" << p.x() << ", " << -p.y() << ")";
+    return os.str();
+  }
+
+  /// Refuses outlines that cross or touch themselves or each other (closer than `tol`, mesh
+  /// units), naming them and the place in the drawing's user units. The fill rules below look
+  /// at one point of each outline and hold only for outlines that do not cross; the curve kernel
+  /// checks only the outlines they keep. So crossing outlines were meshed as some other region
+  /// without a word: two overlapping squares in one path (area 112 drawn) as the first square
+  /// alone (area 100), the second left out as "filled on both sides" at its probe point.
+  void check_outlines(const std::vector<std::vector<Candidate>>& all, double tol) const {
+    struct Outline {
+      const Candidate* c;
+      Loop loop;
+      Box<2> box;
+    };
+    std::vector<Outline> outlines;
+    for (const std::vector<Candidate>& cands : all)
+      for (const Candidate& c : cands) {
+        Outline o{&c, loop_from_beziers(c.pieces, c.name), Box<2>::empty()};
+        for (const Bezier& b : c.pieces)
+          for (const P2& p : b) o.box.expand(p);
+        outlines.push_back(std::move(o));
+      }
+    for (const Outline& o : outlines)
+      if (const std::optional<P2> p = loop_self_intersection(o.loop, tol))
+        fail(o.c->pos, o.c->name + " crosses or touches itself at " + user_coords(*p));
+    for (std::size_t j = 1; j < outlines.size(); ++j)
+      for (std::size_t i = 0; i < j; ++i) {
+        const Outline &a = outlines[i], &b = outlines[j];
+        const P2 gap = (b.box.lo - a.box.hi).cwiseMax(a.box.lo - b.box.hi);
+        if (gap.maxCoeff() > tol) continue;
+        if (const std::optional<P2> p = loops_intersection(a.loop, b.loop, tol))
+          fail(b.c->pos, b.c->name + " and " + a.c->name + " cross or touch at " + user_coords(*p) +
+                             ": outlines must not meet (overlapping shapes are not merged; draw their union as one outline)");
+      }
+  }
+
   static P2 eval(const Bezier& b, double t) {
     const double s = 1.0 - t;
     return s * s * s * b[0] + 3.0 * s * s * t * b[1] + 3.0 * s * t * t * b[2] + t * t * t * b[3];
@@ -326,7 +369,7 @@ class SvgReader {
         }
         c.area = signed_area(c.pieces);
         if (std::abs(c.area) <= 1e-14 * size * size)
-          fail(s.pos, c.name + where("", first).substr(1) + "encloses zero area (a degenerate loop)");
+          fail(s.pos, c.name + " near " + user_coords(first) + ": encloses zero area (a degenerate loop)");
         c.polyline = flatten(c.pieces, 1e-7 * size);
         std::size_t longest = 0;
         double best = -1.0;
@@ -341,11 +384,13 @@ class SvgReader {
         cands.push_back(std::move(c));
       }
     }
+    // The same tolerance as the curve kernel's checks (check_tolerance: 1e-10 of the size).
+    check_outlines(all, 1e-10 * box.extent().maxCoeff());
     // Which side of each subpath is solid? Just inside it the winding number of its shape is the
     // other subpaths' winding plus its own orientation; just outside, the others' alone. It
     // bounds the shape only if the fill rule fills one side and not the other; it bounds the
-    // drawing (the union of the shapes) only if no other shape covers it. Shapes are assumed not
-    // to cross each other (the curve kernel refuses intersecting loops).
+    // drawing (the union of the shapes) only if no other shape covers it. No two outlines meet
+    // (check_outlines).
     auto filled = [](FillRule rule, int w) { return rule == FillRule::EvenOdd ? (w % 2 != 0) : (w != 0); };
     auto shape_winding = [&](std::size_t si, const P2& p, std::size_t skip) {
       int w = 0;

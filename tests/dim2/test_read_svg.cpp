@@ -406,6 +406,12 @@ TEST_CASE("bad SVG inputs are refused with file, place and reason", "[svg][bad]"
       {"huge_path.svg", ":2:19: ", "1e15"},
       {"no_geometry.svg", "no_geometry.svg: ", "no geometry"},
       {"zero_area.svg", ":2:3: .*near \\(0, -?0\\)", "zero area"},
+      // Outlines that cross: refused before the fill rules (which assume they do not) could
+      // mesh one square of the two (area 100 of 112) or the rect without the circle; the place
+      // in the drawing's units, y down as in the file.
+      {"crossing_subpaths.svg", ":2:3: path 1, subpath 2 and path 1, subpath 1 .*at \\(10, 2\\)", "must not meet"},
+      {"crossing_shapes.svg", ":3:3: circle 2, subpath 1 and rect 1, subpath 1 .*at \\(10, [28]\\)", "must not meet"},
+      {"self_crossing.svg", ":2:3: path 1, subpath 1 .*at \\(6.66666667, 6.66666667\\)", "crosses or touches itself"},
       {"bad_transform.svg", ":2:32: ", "unknown transform 'shear'"},
       {"not_svg.svg", ":1:1: ", "not <svg>"},
       {"unknown_entity.svg", ":2:\\d+: ", "unknown entity"},
