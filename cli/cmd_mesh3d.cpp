@@ -151,8 +151,9 @@ const char* help_text =
     "  --no-figures        same as --figures none\n"
     "  --allow-invalid     write the mesh even if validation fails (exit status 1 still)\n"
     "  --quiet             no progress on stderr\n\n"
-    "Bad input (open, non-manifold or self-intersecting surface, unreadable file) exits with\n"
-    "status 1 and writes nothing; so does a surface whose boundary octants cannot be built\n"
+    "Bad input (open, non-manifold or self-intersecting surface: two of its triangles that\n"
+    "share no vertex cross or touch; unreadable file) exits with status 1 and writes\n"
+    "nothing; so does a surface whose boundary octants cannot be built\n"
     "up to the maximum level or within the work bound. A coarse level refused cheaply (under\n"
     "2*10^6 octants) is tried once more one level finer, with a warning: after the lattice\n"
     "draws, when none of them stands undegraded.\n";

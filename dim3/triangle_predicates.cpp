@@ -149,8 +149,8 @@ bool triangles_intersect(const P3 (&t1)[3], const P3 (&t2)[3]) {
                         side2[1] == 0 && side2[2] == 0;
   if (!coplanar) {
     for (int i = 0; i < 3; ++i) {
-      if (segment_triangle(t1[i], t1[(i + 1) % 3], t2[0], t2[1], t2[2]) == Crossing::Proper) return true;
-      if (segment_triangle(t2[i], t2[(i + 1) % 3], t1[0], t1[1], t1[2]) == Crossing::Proper) return true;
+      if (segment_triangle(t1[i], t1[(i + 1) % 3], t2[0], t2[1], t2[2]) != Crossing::Miss) return true;
+      if (segment_triangle(t2[i], t2[(i + 1) % 3], t1[0], t1[1], t1[2]) != Crossing::Miss) return true;
     }
     return false;
   }
@@ -162,12 +162,9 @@ bool triangles_intersect(const P3 (&t1)[3], const P3 (&t2)[3]) {
   }
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      if (segments_meet_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3], true)) return true;
-  const P2 ca = (a[0] + a[1] + a[2]) / 3.0, cb = (b[0] + b[1] + b[2]) / 3.0;
-  for (int i = 0; i < 3; ++i)
-    if (in_triangle_2d(a[i], b[0], b[1], b[2], true) || in_triangle_2d(b[i], a[0], a[1], a[2], true))
-      return true;
-  return in_triangle_2d(ca, b[0], b[1], b[2], true) || in_triangle_2d(cb, a[0], a[1], a[2], true);
+      if (segments_meet_2d(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3], false)) return true;
+  // No edges meet: they meet only if one lies inside the other.
+  return in_triangle_2d(a[0], b[0], b[1], b[2], false) || in_triangle_2d(b[0], a[0], a[1], a[2], false);
 }
 
 bool box_triangle_overlap(const Box<3>& box, const P3& a, const P3& b, const P3& c) {

@@ -49,8 +49,11 @@ Crossing segment_triangle(const P3& p, const P3& q, const P3& a, const P3& b, co
 /// or passes outside. Callers bound s themselves (a ray: s > 0; the segment: 0 < s <= 1).
 double line_triangle_parameter(const P3& p, const P3& q, const P3& a, const P3& b, const P3& c);
 
-/// Do two triangles that share no vertex intersect beyond the tolerance? Non-coplanar pairs:
-/// some edge of one properly crosses the other. Coplanar pairs: their interiors overlap.
+/// Do two triangles that share no vertex meet (within the tolerance)? Non-coplanar pairs: some
+/// edge of one meets the other, crossing or touching. Coplanar pairs: their closed triangles
+/// overlap or touch. Touching counts: two sheets of a surface that meet, however they meet, are
+/// not a valid solid boundary (two copies of a sphere mirrored about a plane cross exactly
+/// through each other's edges, every contact a touch: counted as crossings only, none was found).
 bool triangles_intersect(const P3 (&t1)[3], const P3 (&t2)[3]);
 
 /// Does the closed triangle meet the closed box? (separating axis test, Akenine-Moeller)

@@ -43,14 +43,51 @@ TEST_CASE("self-intersections: pruned search equals all pairs", "[surface_checks
   CHECK(self_intersections_ref(sphere).empty());
 }
 
-TEST_CASE("coplanar overlapping triangles intersect; touching at a vertex does not", "[surface_checks]") {
+TEST_CASE("triangles that share no vertex meet when they cross, overlap or touch", "[surface_checks]") {
   const P3 a[3] = {P3(0, 0, 0), P3(1, 0, 0), P3(0, 1, 0)};
   const P3 b[3] = {P3(0.2, 0.2, 0), P3(1.2, 0.2, 0), P3(0.2, 1.2, 0)};
   CHECK(triangles_intersect(a, b));
-  const P3 c[3] = {P3(1, 0, 0), P3(2, 0, 0), P3(1, 1, 0)};  // shares the point (1, 0, 0) only
-  CHECK_FALSE(triangles_intersect(a, c));
+  // Coplanar, touching at the point (1, 0, 0) only (a corner of each, not a shared vertex of
+  // the surface): two sheets meet there.
+  const P3 c[3] = {P3(1, 0, 0), P3(2, 0, 0), P3(1, 1, 0)};
+  CHECK(triangles_intersect(a, c));
+  const P3 apart[3] = {P3(1.01, 0, 0), P3(2, 0, 0), P3(1.01, 1, 0)};
+  CHECK_FALSE(triangles_intersect(a, apart));
+  const P3 inside[3] = {P3(0.1, 0.1, 0), P3(0.3, 0.1, 0), P3(0.1, 0.3, 0)};  // within a, edges apart
+  CHECK(triangles_intersect(a, inside));
+  CHECK(triangles_intersect(inside, a));
   const P3 d[3] = {P3(0.2, 0.2, -1), P3(0.2, 0.2, 1), P3(3, 3, 0)};  // pierces a
   CHECK(triangles_intersect(a, d));
+  // Not coplanar: a corner on a's interior, or an edge lying in a's plane across it: touches.
+  const P3 corner_on[3] = {P3(0.2, 0.2, 0), P3(0.2, 0.2, 1), P3(1, 1, 1)};
+  CHECK(triangles_intersect(a, corner_on));
+  const P3 edge_in_plane[3] = {P3(0.5, -1, 0), P3(0.5, 1, 0), P3(0.5, 0, 1)};  // an edge in a's plane, across a
+  CHECK(triangles_intersect(a, edge_in_plane));
+  const P3 above[3] = {P3(0.2, 0.2, 0.01), P3(0.2, 0.2, 1), P3(1, 1, 1)};
+  CHECK_FALSE(triangles_intersect(a, above));
+}
+
+TEST_CASE("two spheres crossing exactly through each other's edges are self-intersecting", "[surface_checks]") {
+  // sphere966 and a copy moved by its radius along x: mirror images about x = 5, so every point
+  // where they cross lies on an edge of both (the contacts are touches, no proper crossing; the
+  // search once counted proper crossings only and passed this surface, which mesh3d then failed
+  // on with 'the boundary octants cannot be built' instead of naming the input's fault).
+  const TriangleSoup one = read_surface(std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off");
+  TriangleSoup two = one;
+  const auto n = static_cast<std::int32_t>(one.vertices.size());
+  for (const P3& p : one.vertices) two.vertices.push_back(p + P3(10, 0, 0));
+  for (const Triangle& t : one.triangles) two.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const Surface s(two);
+  const AabbTree tree(s.vertices(), s.triangles());
+  const auto fast = self_intersections(s, tree);
+  CHECK_FALSE(fast.empty());
+  CHECK(fast == self_intersections_ref(s));
+  // Moved apart (by 2.5 radii): no contact.
+  TriangleSoup apart = one;
+  for (const P3& p : one.vertices) apart.vertices.push_back(p + P3(25, 0, 0));
+  for (const Triangle& t : one.triangles) apart.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const Surface sa(apart);
+  CHECK(self_intersections(sa, AabbTree(sa.vertices(), sa.triangles())).empty());
 }
 
 TEST_CASE("closedness, manifoldness and orientation checks", "[surface_checks]") {
