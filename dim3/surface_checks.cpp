@@ -223,6 +223,26 @@ int orient_outward(Surface& s, const std::string& name, AabbTree* tree) {
 
 AabbTree validate_surface(Surface& s, const std::string& name) {
   if (s.n_triangles() == 0) throw InputError(name + ": empty surface (no triangles)");
+  {
+    // The predicates multiply up to three lengths (orient3d) and compare squared ones: at
+    // 1e200 or 1e-200 across they overflow or underflow, and every triangle looked degenerate
+    // ("12 degenerate (zero-area) triangle(s)" for a cube 1e200 across). Said as it is instead.
+    const Box<3> b = s.bounding_box();
+    const double largest = std::max(b.lo.cwiseAbs().maxCoeff(), b.hi.cwiseAbs().maxCoeff());
+    const double across = b.extent().maxCoeff();
+    std::ostringstream os;
+    os << std::setprecision(3);
+    if (largest > max_surface_coordinate) {
+      os << name << ": coordinates up to " << largest << " exceed the largest accepted magnitude " << max_surface_coordinate
+         << " (scale the surface)";
+      throw InputError(os.str());
+    }
+    if (!(across >= min_surface_extent)) {
+      os << name << ": the surface is " << across << " across, under the smallest accepted extent " << min_surface_extent
+         << " (scale the surface)";
+      throw InputError(os.str());
+    }
+  }
   if (const auto bad = non_manifold_edges(s); !bad.empty())
     throw InputError(name + ": non-manifold: " + std::to_string(bad.size()) +
                      " edge(s) with more than two triangles, e.g. the edge " + fmt_edge(s, bad[0]) + " has " +

@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "core/error.hpp"
 #include "dim3/read_surface.hpp"
 #include "dim3/surface.hpp"
 #include "dim3/surface_checks.hpp"
@@ -125,4 +126,25 @@ TEST_CASE("closedness, manifoldness and orientation checks", "[surface_checks]")
   TriangleSoup flat = tetrahedron(P3::Zero());
   flat.vertices[3] = P3(0.5, 0.5, 0.0);
   CHECK_FALSE(degenerate_triangles(Surface(flat)).empty());
+}
+
+TEST_CASE("coordinates out of range are refused as such, not as degenerate triangles", "[surface_checks]") {
+  const auto message = [](double scale, double shift) {
+    TriangleSoup t = tetrahedron(P3::Zero());
+    for (P3& p : t.vertices) p = p * scale + P3::Constant(shift);
+    Surface s(t);
+    try {
+      (void)validate_surface(s, "t.off");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  // Both overflowed or underflowed the predicates' products: "4 degenerate (zero-area) triangle(s)".
+  CHECK_THAT(message(1e200, 0), Catch::StartsWith("t.off: coordinates up to 1e+200 exceed the largest accepted magnitude"));
+  CHECK_THAT(message(1, 1e16), Catch::Contains("exceed the largest accepted magnitude 1e+15"));
+  CHECK_THAT(message(1e-200, 0), Catch::StartsWith("t.off: the surface is 1e-200 across, under the smallest accepted extent"));
+  CHECK(message(1e14, 0).empty());
+  CHECK(message(1e-50, 0).empty());
+  CHECK(message(1, 1e14).empty());
 }
