@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "core/error.hpp"
 #include "dim3/read_surface.hpp"
@@ -80,11 +81,51 @@ Declared declared_counts(const std::string& path, const std::string& ext) {
   return out;
 }
 
+/// A binary STL whose size is not what its triangle count says (84 + 50 n bytes): truncated or
+/// not an STL. OpenMesh read such files as empty ("empty surface (no faces)"). A file that is
+/// text (ASCII STL) is left to the reader.
+void check_binary_stl_size(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const auto is_text = [](unsigned char c) {
+    return c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v' || (c >= 32 && c < 127);
+  };
+  // Text up to the end (an ASCII STL), or binary from its first other byte (a binary STL's
+  // floats have some within the first triangles; its header may read "solid ...").
+  char header[84] = {};
+  long long size = 0;
+  bool text = true;
+  std::vector<char> chunk(1 << 16);
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (size < 84) std::memcpy(header + size, chunk.data(), std::min<std::size_t>(got, static_cast<std::size_t>(84 - size)));
+    size += static_cast<long long>(got);
+    if (std::any_of(chunk.begin(), chunk.begin() + static_cast<std::ptrdiff_t>(got), [&](char c) { return !is_text(static_cast<unsigned char>(c)); })) {
+      text = false;
+      break;
+    }
+  }
+  if (text) return;
+  in.clear();
+  in.seekg(0, std::ios::end);
+  size = static_cast<long long>(in.tellg());
+  if (size < 84)
+    throw InputError(path + ": not an STL: " + std::to_string(size) +
+                     " bytes of binary data, shorter than a binary STL's 84-byte header");
+  std::uint32_t n = 0;
+  std::memcpy(&n, header + 80, 4);  // little-endian on every platform we build for
+  const long long expected = 84 + 50LL * n;
+  if (expected != size)
+    throw InputError(path + ": truncated or malformed binary STL: its header declares " + std::to_string(n) +
+                     " triangles (" + std::to_string(expected) + " bytes), the file has " + std::to_string(size) + " bytes");
+}
+
 }  // namespace
 
 TriangleSoup read_with_openmesh(const std::string& path) {
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
+  if (ext == "stl") check_binary_stl_size(path);
   OmMesh mesh;
   OpenMesh::IO::Options options;
   // OpenMesh reports refused faces on omerr; the count check below turns them into an error.

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -231,7 +232,15 @@ TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_su
       b.write(reinterpret_cast<const char*>(&attr), 2);
     }
   }
-  for (const fs::path& path : {obj, ply, ascii, binary}) {
+  // A binary STL whose header begins with "solid", as some exporters write it.
+  const fs::path solid_binary = scratch("cube-binary-solid.stl");
+  {
+    std::ifstream in(binary, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    bytes.replace(0, 11, "solid cube ");
+    std::ofstream(solid_binary, std::ios::binary) << bytes;
+  }
+  for (const fs::path& path : {obj, ply, ascii, binary, solid_binary}) {
     INFO(path);
     Surface s(read_surface(path.string()));
     CHECK(s.n_triangles() == 12);
@@ -240,4 +249,24 @@ TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_su
     CHECK(s.volume() == Approx(1.0));
     CHECK(s.euler_characteristic() == 2);
   }
+  // Cut short, or too short for a header: said so (OpenMesh read both as empty, and the
+  // message was "empty surface (no faces)").
+  const fs::path cut = scratch("cube-binary-cut.stl"), stub = scratch("stub.stl");
+  {
+    std::ifstream in(binary, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, 84 + 50 * 5 + 10);
+    std::ofstream(stub, std::ios::binary) << bytes.substr(0, 50);
+  }
+  const auto refusal = [](const fs::path& path) {
+    try {
+      (void)read_surface(path.string());
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK_THAT(refusal(cut), Catch::StartsWith(cut.string()) &&
+                               Catch::Contains("truncated or malformed binary STL: its header declares 12 triangles (684 bytes), the file has 344 bytes"));
+  CHECK_THAT(refusal(stub), Catch::Contains("not an STL: 50 bytes of binary data"));
 }
