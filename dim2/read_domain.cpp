@@ -53,6 +53,16 @@ std::string where(const std::string& source, const P2& p) {
   return os.str();
 }
 
+void check_loop_extent(const Box<2>& box, const std::string& place) {
+  const double across = box.extent().maxCoeff();
+  if (across >= min_loop_extent) return;
+  std::ostringstream os;
+  os.precision(3);
+  os << place << "the loop is " << across << " across, under the smallest accepted extent " << min_loop_extent
+     << " (scale the input)";
+  throw InputError(os.str());
+}
+
 void check_level(double level, const std::string& place) {
   constexpr double max_level = 28.0;
   if (!std::isfinite(level)) throw InputError(place + "control level is not a finite number");

@@ -27,6 +27,14 @@ std::string where(const std::string& source, TextPos p);
 /// "SOURCE: near (x, y): " for messages about geometry (mesh coordinates).
 std::string where(const std::string& source, const P2& p);
 
+/// The smallest loop the readers accept, across: below it its area (a product of two lengths)
+/// underflows and the loop read as "zero area" (a square 1e-150 across still meshes).
+inline constexpr double min_loop_extent = 1e-150;
+
+/// Refuses a loop whose control points' box is under min_loop_extent across: InputError
+/// "`place`the loop is X across, under the smallest accepted extent 1e-150 (scale the input)".
+void check_loop_extent(const Box<2>& box, const std::string& place);
+
 /// Refuses a mesh control parameter outside [0, 28] with the memory a full tree of that depth
 /// would need (4^level cells of about 12 bytes); `place` prefixes the message.
 void check_level(double level, const std::string& place);

@@ -250,7 +250,7 @@ class SvgReader {
   static std::string user_coords(const P2& p) {
     std::ostringstream os;
     os.precision(9);
-    os << "(" << p.x() << ", " << -p.y() << ")";
+    os << "(" << p.x() + 0.0 << ", " << -p.y() + 0.0 << ")";  // (+ 0.0: no "-0")
     return os.str();
   }
 
@@ -367,6 +367,10 @@ class SvgReader {
         } else {
           c.pieces.push_back(straight_cubic(last, first));
         }
+        Box<2> own = Box<2>::empty();
+        for (const Bezier& b : c.pieces)
+          for (const P2& p : b) own.expand(p);
+        check_loop_extent(own, where(source_, s.pos) + c.name + " near " + user_coords(first) + ": ");
         c.area = signed_area(c.pieces);
         if (std::abs(c.area) <= 1e-14 * size * size)
           fail(s.pos, c.name + " near " + user_coords(first) + ": encloses zero area (a degenerate loop)");

@@ -100,6 +100,8 @@ TEST_CASE("bad native inputs are refused with file, place and reason", "[native]
       {"unknown_key.json", ": /loops/0/points/0/corners: ", "unknown key"},
       {"no_loops.json", ": /loops: ", "no geometry"},
       {"zero_area.json", "near \\(0, 0\\)|/loops/0", "zero"},
+      // 1e-200 across: its area underflowed and it read as "zero area".
+      {"tiny_loop.json", "/loops/0 \\(\"sq\"\\): ", "the loop is 1e-200 across, under the smallest accepted extent 1e-150"},
       {"two_points.json", ": /loops/0/points: ", "at least 3"},
       {"string_number.json", ": /loops/0/points/0/x: ", "must be a number"},
       {"huge_number.json", ": /loops/0/points/1/x: ", "1e15"},

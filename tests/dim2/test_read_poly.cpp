@@ -66,6 +66,7 @@ TEST_CASE("bad .poly inputs are refused with file, place and reason", "[poly][ba
       {"truncated.poly", ":\\d+:\\d+: ", "file ends"},
       {"bad_number.poly", ":3:5: ", "y coordinate"},
       {"zero_length_segment.poly", ":8:3: ", "zero length"},
+      {"tiny_loop.poly", "loop 1 \\(from segment 1\\): ", "the loop is 1e-200 across, under the smallest accepted extent 1e-150"},
       {"bad_index.poly", ":8:5: ", "out of range"},
   };
   for (const auto& c : cases) test::check_bad_input(c);

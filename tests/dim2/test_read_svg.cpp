@@ -406,6 +406,7 @@ TEST_CASE("bad SVG inputs are refused with file, place and reason", "[svg][bad]"
       {"huge_path.svg", ":2:19: ", "1e15"},
       {"no_geometry.svg", "no_geometry.svg: ", "no geometry"},
       {"zero_area.svg", ":2:3: .*near \\(0, -?0\\)", "zero area"},
+      {"tiny_loop.svg", ":2:3: rect 1, subpath 1 near \\(0, 0\\): ", "the loop is 1e-200 across, under the smallest accepted extent 1e-150"},
       // Outlines that cross: refused before the fill rules (which assume they do not) could
       // mesh one square of the two (area 100 of 112) or the rect without the circle; the place
       // in the drawing's units, y down as in the file.
