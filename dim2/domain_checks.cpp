@@ -148,6 +148,19 @@ std::optional<P2> loops_intersection(const Loop& a, const Loop& b, double tol) {
   return sweep_pairs(sa, &sb, tol, [&](const Segment& x, const Segment& y) { return meet(x.q, y.q, false, false, tol, 200); });
 }
 
+std::optional<LoopsMeeting> first_loops_intersection(const std::vector<Loop>& loops, double tol) {
+  std::vector<Box<2>> boxes;
+  boxes.reserve(loops.size());
+  for (const Loop& l : loops) boxes.push_back(bounding_box(l));
+  for (std::size_t i = 0; i < loops.size(); ++i)
+    for (std::size_t j = i + 1; j < loops.size(); ++j) {
+      const P2 gap = (boxes[j].lo - boxes[i].hi).cwiseMax(boxes[i].lo - boxes[j].hi);
+      if (gap.maxCoeff() > tol) continue;
+      if (const std::optional<P2> p = loops_intersection(loops[i], loops[j], tol)) return LoopsMeeting{i, j, *p};
+    }
+  return std::nullopt;
+}
+
 std::optional<P2> polyline_intersection_ref(const Loop& a, const Loop* b, int samples) {
   auto poly = [&](const Loop& l) {
     std::vector<P2> v;
@@ -221,15 +234,9 @@ void check_domain(const Domain& domain) {
     const double size = bounding_box(l).extent().norm();
     if (std::abs(signed_area(l)) <= 1e-12 * size * size) throw zero_area(l);
   }
-  for (std::size_t i = 0; i < domain.loops.size(); ++i)
-    for (std::size_t j = i + 1; j < domain.loops.size(); ++j) {
-      const Box<2> bi = bounding_box(domain.loops[i]), bj = bounding_box(domain.loops[j]);
-      const P2 gap = (bj.lo - bi.hi).cwiseMax(bi.lo - bj.hi);
-      if (gap.maxCoeff() > tol) continue;
-      if (auto p = loops_intersection(domain.loops[i], domain.loops[j], tol))
-        throw InputError(src + ": loops '" + domain.loops[i].name + "' and '" + domain.loops[j].name +
-                         "' intersect at " + coords(*p));
-    }
+  if (const std::optional<LoopsMeeting> m = first_loops_intersection(domain.loops, tol))
+    throw InputError(src + ": loops '" + domain.loops[m->i].name + "' and '" + domain.loops[m->j].name + "' intersect at " +
+                     coords(m->at));
   for (const InteriorControl& c : domain.interior)
     if (!std::isfinite(c.p.x()) || !std::isfinite(c.p.y()) || !std::isfinite(c.level) || !(c.radius >= 0.0))
       throw InputError(src + ": interior control point at " + coords(c.p) + " has a non-finite position, level or radius");

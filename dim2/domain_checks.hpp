@@ -15,6 +15,13 @@ namespace febemesh::dim2 {
 std::optional<P2> loop_self_intersection(const Loop& loop, double tol);
 /// A point where two different loops meet (closer than `tol`), if any.
 std::optional<P2> loops_intersection(const Loop& a, const Loop& b, double tol);
+/// The first two loops that meet (closer than `tol`), in the order (i, j), i < j, with where:
+/// check_domain's pair check, also run by the SVG reader on every outline before its fill rules.
+struct LoopsMeeting {
+  std::size_t i = 0, j = 0;
+  P2 at = P2::Zero();
+};
+std::optional<LoopsMeeting> first_loops_intersection(const std::vector<Loop>& loops, double tol);
 /// Slow twin of both: any two non-adjacent chords of dense polylines (`samples` per piece)
 /// that cross. Finds transversal crossings only; for tests.
 std::optional<P2> polyline_intersection_ref(const Loop& a, const Loop* b, int samples = 64);

@@ -53,14 +53,13 @@ std::string where(const std::string& source, const P2& p) {
   return os.str();
 }
 
-void check_loop_extent(const Box<2>& box, const std::string& place) {
+std::optional<std::string> loop_extent_problem(const Box<2>& box) {
   const double across = box.extent().maxCoeff();
-  if (across >= min_loop_extent) return;
+  if (across >= min_loop_extent) return std::nullopt;
   std::ostringstream os;
   os.precision(3);
-  os << place << "the loop is " << across << " across, under the smallest accepted extent " << min_loop_extent
-     << " (scale the input)";
-  throw InputError(os.str());
+  os << "the loop is " << across << " across, under the smallest accepted extent " << min_loop_extent << " (scale the input)";
+  return os.str();
 }
 
 void check_level(double level, const std::string& place) {

@@ -3,6 +3,7 @@
 // B-spline, .svg, .poly), or by the content when there is no extension. Every reader refuses bad
 // input with InputError naming the file, the place and the reason (DESIGN.md contracts).
 
+#include <optional>
 #include <string>
 
 #include "dim2/curve_model.hpp"
@@ -31,9 +32,10 @@ std::string where(const std::string& source, const P2& p);
 /// underflows and the loop read as "zero area" (a square 1e-150 across still meshes).
 inline constexpr double min_loop_extent = 1e-150;
 
-/// Refuses a loop whose control points' box is under min_loop_extent across: InputError
-/// "`place`the loop is X across, under the smallest accepted extent 1e-150 (scale the input)".
-void check_loop_extent(const Box<2>& box, const std::string& place);
+/// For a loop whose control points' box is under min_loop_extent across, the reason to refuse
+/// it: "the loop is X across, under the smallest accepted extent 1e-150 (scale the input)"; the
+/// reader adds the place (built only then).
+std::optional<std::string> loop_extent_problem(const Box<2>& box);
 
 /// Refuses a mesh control parameter outside [0, 28] with the memory a full tree of that depth
 /// would need (4^level cells of about 12 bytes); `place` prefixes the message.

@@ -112,7 +112,8 @@ class NativeReader {
     Loop loop = loop_from_bspline(cps, name);
     Box<2> box = Box<2>::empty();
     for (const auto& c : cps) box.expand(c.p);
-    check_loop_extent(box, where(source_, cps.front().p) + pointer + " (\"" + name + "\"): ");
+    if (const std::optional<std::string> why = loop_extent_problem(box))
+      throw InputError(where(source_, cps.front().p) + pointer + " (\"" + name + "\"): " + *why);
     const double size = box.extent().norm();
     if (loop.pieces.empty() || std::abs(signed_area(loop.pieces)) <= 1e-14 * size * size)
       throw InputError(where(source_, cps.front().p) + pointer + " (\"" + name + "\"): loop encloses zero area (degenerate)");

@@ -229,8 +229,9 @@ Domain parse_poly(const std::string& text, const std::string& source, const std:
     const double area = shoelace(poly);
     Box<2> box = Box<2>::empty();
     for (const auto& p : poly) box.expand(p);
-    check_loop_extent(box, where(source, poly.front()) + "loop " + std::to_string(polys.size() + 1) + " (from segment " +
-                               std::to_string(s0 + base) + "): ");
+    if (const std::optional<std::string> why = loop_extent_problem(box))
+      throw InputError(where(source, poly.front()) + "loop " + std::to_string(polys.size() + 1) + " (from segment " +
+                       std::to_string(s0 + base) + "): " + *why);
     if (std::abs(area) <= 1e-14 * box.extent().squaredNorm())
       throw InputError(where(source, poly.front()) + "loop " + std::to_string(polys.size() + 1) + " (from segment " +
                        std::to_string(s0 + base) + ") encloses zero area");

@@ -261,31 +261,19 @@ class SvgReader {
   /// without a word: two overlapping squares in one path (area 112 drawn) as the first square
   /// alone (area 100), the second left out as "filled on both sides" at its probe point.
   void check_outlines(const std::vector<std::vector<Candidate>>& all, double tol) const {
-    struct Outline {
-      const Candidate* c;
-      Loop loop;
-      Box<2> box;
-    };
-    std::vector<Outline> outlines;
-    for (const std::vector<Candidate>& cands : all)
-      for (const Candidate& c : cands) {
-        Outline o{&c, loop_from_beziers(c.pieces, c.name), Box<2>::empty()};
-        for (const Bezier& b : c.pieces)
-          for (const P2& p : b) o.box.expand(p);
-        outlines.push_back(std::move(o));
+    std::vector<const Candidate*> cands;
+    std::vector<Loop> loops;
+    for (const std::vector<Candidate>& shape : all)
+      for (const Candidate& c : shape) {
+        cands.push_back(&c);
+        loops.push_back(loop_from_beziers(c.pieces, c.name));
       }
-    for (const Outline& o : outlines)
-      if (const std::optional<P2> p = loop_self_intersection(o.loop, tol))
-        fail(o.c->pos, o.c->name + " crosses or touches itself at " + user_coords(*p));
-    for (std::size_t j = 1; j < outlines.size(); ++j)
-      for (std::size_t i = 0; i < j; ++i) {
-        const Outline &a = outlines[i], &b = outlines[j];
-        const P2 gap = (b.box.lo - a.box.hi).cwiseMax(a.box.lo - b.box.hi);
-        if (gap.maxCoeff() > tol) continue;
-        if (const std::optional<P2> p = loops_intersection(a.loop, b.loop, tol))
-          fail(b.c->pos, b.c->name + " and " + a.c->name + " cross or touch at " + user_coords(*p) +
-                             ": outlines must not meet (overlapping shapes are not merged; draw their union as one outline)");
-      }
+    for (std::size_t k = 0; k < loops.size(); ++k)
+      if (const std::optional<P2> p = loop_self_intersection(loops[k], tol))
+        fail(cands[k]->pos, cands[k]->name + " crosses or touches itself at " + user_coords(*p));
+    if (const std::optional<LoopsMeeting> m = first_loops_intersection(loops, tol))
+      fail(cands[m->j]->pos, cands[m->j]->name + " and " + cands[m->i]->name + " cross or touch at " + user_coords(m->at) +
+                                 ": outlines must not meet (overlapping shapes are not merged; draw their union as one outline)");
   }
 
   static P2 eval(const Bezier& b, double t) {
@@ -370,7 +358,8 @@ class SvgReader {
         Box<2> own = Box<2>::empty();
         for (const Bezier& b : c.pieces)
           for (const P2& p : b) own.expand(p);
-        check_loop_extent(own, where(source_, s.pos) + c.name + " near " + user_coords(first) + ": ");
+        if (const std::optional<std::string> why = loop_extent_problem(own))
+          fail(s.pos, c.name + " near " + user_coords(first) + ": " + *why);
         c.area = signed_area(c.pieces);
         if (std::abs(c.area) <= 1e-14 * size * size)
           fail(s.pos, c.name + " near " + user_coords(first) + ": encloses zero area (a degenerate loop)");
