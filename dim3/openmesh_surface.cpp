@@ -81,9 +81,11 @@ Declared declared_counts(const std::string& path, const std::string& ext) {
   return out;
 }
 
-/// A binary STL whose size is not what its triangle count says (84 + 50 n bytes): truncated or
-/// not an STL. OpenMesh read such files as empty ("empty surface (no faces)"). A file that is
-/// text (ASCII STL) is left to the reader.
+/// Why OpenMesh made nothing of an STL, when it is a binary STL whose size is not what its
+/// triangle count says (84 + 50 n bytes): truncated or not an STL. OpenMesh reads every such file
+/// as empty (a cube's 12 triangles cut after 5, 11 or 11 and a half, or with 2 bytes more), and
+/// the message was "empty surface (no faces)". A file that is text (ASCII STL) is left alone.
+/// Called only once OpenMesh has failed, so a good file is not read twice.
 void check_binary_stl_size(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   const auto is_text = [](unsigned char c) {
@@ -125,7 +127,6 @@ void check_binary_stl_size(const std::string& path) {
 TriangleSoup read_with_openmesh(const std::string& path) {
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
-  if (ext == "stl") check_binary_stl_size(path);
   OmMesh mesh;
   OpenMesh::IO::Options options;
   // OpenMesh reports refused faces on omerr; the count check below turns them into an error.
@@ -133,6 +134,7 @@ TriangleSoup read_with_openmesh(const std::string& path) {
   omerr().disable();
   const bool ok = OpenMesh::IO::read_mesh(mesh, path, options);
   if (err_was_enabled) omerr().enable();
+  if (ext == "stl" && (!ok || mesh.n_faces() == 0)) check_binary_stl_size(path);
   if (!ok) throw InputError(path + ": OpenMesh cannot read the file (unreadable or malformed " + ext + ")");
   if (mesh.n_faces() == 0) throw InputError(path + ": empty surface (no faces)");
 
