@@ -116,8 +116,12 @@ SweepDag sweep_dag(std::size_t n, std::vector<std::int32_t> nodes, const Neighbo
                        const std::int32_t j = position[static_cast<std::size_t>(u)];
                        if (j >= 0 && j != static_cast<std::int32_t>(i)) near.push_back(j);
                      });
-                     std::sort(near.begin(), near.end());
-                     near.erase(std::unique(near.begin(), near.end()), near.end());
+                     // (Lists that come ascending and distinct, as a mesh's neighbours do,
+                     // are taken as they are.)
+                     if (std::adjacent_find(near.begin(), near.end(), std::greater_equal<>{}) != near.end()) {
+                       std::sort(near.begin(), near.end());
+                       near.erase(std::unique(near.begin(), near.end()), near.end());
+                     }
                      const auto later = std::upper_bound(near.begin(), near.end(), static_cast<std::int32_t>(i));
                      d.n_earlier[i] = static_cast<std::int32_t>(later - near.begin());
                      d.next_start[i + 1] = static_cast<std::int32_t>(near.end() - later);

@@ -28,6 +28,7 @@
 
 #include "core/boundary.hpp"
 #include "core/mesh.hpp"
+#include "dim3/node_tets.hpp"
 
 namespace febemesh::dim3 {
 
@@ -81,6 +82,10 @@ struct EdgeRemovalOptions {
   /// uses instead of ranking them all; otherwise they are ranked. Out: those of the output
   /// tetrahedra (the survivors' as handed in or ranked, the new ones ranked). Null: neither.
   std::vector<double>* ranks = nullptr;
+  /// In (when not null): the tetrahedra at each node of the input mesh, used instead of
+  /// listing them again where they fit its size (the caller vouches for the rest: the tet
+  /// optimiser's TetOptimizeOptions::incidence); taken, so left empty.
+  NodeTets* incidence = nullptr;
 };
 
 struct EdgeRemovalStats {

@@ -133,6 +133,9 @@ void improve_quality(const SurfaceBoundary& s, OctantComplex& complex, TetMesh& 
     // The ranks go from each pass to the next (the points do not move in between).
     std::vector<double> ranks;
     to.ranks = &ranks;
+    // Likewise each pass's node -> tetrahedra lists to the edge removal after it.
+    NodeTets node_tets;
+    to.incidence = &node_tets;
     const TetOptimizeStats ts = optimize_tets(fe.mesh, fe.where, to);
     r.n_optimize_moves = ts.moves;
     if (opt.slide_feature_nodes && slide_on_lines(s, complex, fe, to) > 0) {
@@ -172,6 +175,7 @@ void improve_quality(const SurfaceBoundary& s, OctantComplex& complex, TetMesh& 
       eo.n_threads = opt.n_threads;
       eo.contract_below_deg = opt.contract_edges_below_deg;
       eo.ranks = &ranks;
+      eo.incidence = &node_tets;
       // Contractions keep the corners. Nodes snapped onto a feature line may go (into a node
       // of theirs): those the sweeps keep fixed include some whose closest point is on a
       // face beside the line (fandisk L5: the smooth-surface end of a 0.0012 edge whose

@@ -23,6 +23,7 @@
 #include "core/boundary.hpp"
 #include "core/box.hpp"
 #include "core/mesh.hpp"
+#include "dim3/node_tets.hpp"
 
 namespace febemesh::dim3 {
 
@@ -87,6 +88,10 @@ struct TetOptimizeOptions {
   /// each at the end, the moved ones' ranked again (the sweeps' own ranks differ to rounding),
   /// so the next pass gets the numbers it would compute. Null: neither.
   std::vector<double>* ranks = nullptr;
+  /// Out (when not null): the tetrahedra at each node of the mesh as it leaves, where the call
+  /// listed them (it moved nodes), else cleared; for the edge removal after it
+  /// (EdgeRemovalOptions::incidence).
+  NodeTets* incidence = nullptr;
 };
 
 struct TetOptimizeStats {

@@ -116,6 +116,18 @@ TEST_CASE("sweep_dag links each node to its neighbours in the sweep", "[ordered_
     check_dag(g, nodes, sweep_dag(n, nodes, g.neighbours()));
     const int threads = *rc::gen::inRange(2, 5);
     check_dag(g, nodes, sweep_dag(n, nodes, g.neighbours(), threads));  // built in parts
+    // Lists ascending and distinct (as a mesh's neighbour lists come: sweep_dag takes them as
+    // they are), and ascending with repeats (sorted again).
+    Graph sorted = g, repeated = g;
+    for (std::size_t v = 0; v < n; ++v) {
+      std::vector<std::int32_t>& a = sorted.adj[v];
+      std::sort(a.begin(), a.end());
+      a.erase(std::unique(a.begin(), a.end()), a.end());
+      repeated.adj[v].clear();
+      for (const std::int32_t u : a) repeated.adj[v].insert(repeated.adj[v].end(), {u, u});
+    }
+    check_dag(sorted, nodes, sweep_dag(n, nodes, sorted.neighbours(), threads));
+    check_dag(repeated, nodes, sweep_dag(n, nodes, repeated.neighbours(), threads));
   });
 }
 

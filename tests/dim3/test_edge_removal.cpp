@@ -15,6 +15,7 @@
 #include <map>
 #include <numeric>
 
+#include "core/incidence_csr.hpp"
 #include "core/mesh.hpp"
 #include "core/read_msh.hpp"
 #include "core/test_mesh_fixtures.hpp"
@@ -429,5 +430,44 @@ TEST_CASE("edge contraction inside a jittered cube keeps a valid mesh of the sam
     RC_ASSERT(min_dihedral(m) >= before - 1e-9);
     RC_ASSERT(faces_match(m));
     RC_ASSERT(validate(m, ValidateOptions<3>{}).valid);
+  });
+}
+
+TEST_CASE("the optimiser's node lists handed to edge removal give the mesh it makes alone", "[edge_removal][property]") {
+  test::prop("jittered Kuhn cubes, optimised, then edges removed", 20, [](unsigned seed) {
+    Mesh<3> m = jittered_kuhn_grid(seed, 0.6);
+    std::vector<BoundaryLocation> where(m.points.size());
+    for (const VertexId n : m.interface.node) where[n.v].patch = 0;  // (not moved: no projection)
+    TetOptimizeOptions to;
+    to.max_sweeps = 4;
+    to.n_threads = 1 + static_cast<int>(seed % 2);
+    NodeTets handed;
+    to.incidence = &handed;
+    const TetOptimizeStats ts = optimize_tets(m, where, to);
+    RC_TAG(ts.moves > 0 ? "moved" : "none");
+    // The lists as handed out: those of the mesh's tetrahedra, each node's ascending.
+    std::vector<std::int32_t> start, tets;
+    incidence_csr(
+        m.points.size(), m.solid.size(),
+        [&](std::size_t e, auto&& f) {
+          for (int k = 0; k < 4; ++k) f(m.solid.nodes(ElemId{static_cast<std::int32_t>(e)})[k].v);
+        },
+        1, start, tets);
+    // (Listed where some tetrahedron was under the target, so that nodes were searched.)
+    RC_ASSERT(handed.start.empty() == !(ts.min_dihedral_before_deg < to.target_dihedral_deg));
+    if (!handed.start.empty()) {
+      RC_ASSERT(handed.start == start);
+      RC_ASSERT(handed.tets == tets);
+    }
+    Mesh<3> alone = m;
+    EdgeRemovalOptions eo;
+    eo.below_deg = 30.0;
+    const EdgeRemovalStats a = remove_bad_edges(alone, where, nullptr, eo);
+    eo.incidence = &handed;
+    const EdgeRemovalStats b = remove_bad_edges(m, where, nullptr, eo);
+    RC_ASSERT(a.removed == b.removed);
+    RC_ASSERT(m.solid.node == alone.solid.node);
+    RC_ASSERT(m.interface.node == alone.interface.node);
+    RC_ASSERT(handed.start.empty() && handed.tets.empty());  // taken
   });
 }
