@@ -186,12 +186,16 @@ struct Optimizer {
   std::vector<std::int32_t*> nb_list;
   std::vector<std::int32_t> nb_count;
   std::vector<std::unique_ptr<std::int32_t[]>> nb_blocks;
-  /// list_neighbours' marks, one array a range (at most opt.n_threads), kept from call to call:
-  /// marks[u] == 2v while v's neighbours are counted, 2v + 1 while they are listed, and each v
-  /// is listed once a call of optimize_tets, so no mark is ever cleared. (A fresh array of -1
-  /// for each range of each pass, 0.69 MB at sphere966's 995,232 tetrahedra, however few nodes
-  /// it listed: 64 lists a run took 52 ms on one thread and 44 on two.)
-  std::vector<std::vector<std::uint32_t>> nb_marks;
+  /// list_neighbours' marks of the nodes met, one set a range (at most opt.n_threads), kept
+  /// from call to call: a bit a node, set while one node's neighbours are gathered and cleared
+  /// after (by the list of those set). (A fresh array of -1 for each range of each pass, 0.69 MB
+  /// at sphere966's 995,232 tetrahedra however few nodes it listed: 64 lists a run took 52 ms
+  /// on one thread and 44 on two.)
+  struct Marks {
+    std::vector<std::uint64_t> bits;
+    std::vector<std::int32_t> set;
+  };
+  std::vector<Marks> nb_marks;
   std::span<const std::int32_t> neighbours(std::int32_t v) const {
     return {nb_list[v], static_cast<std::size_t>(nb_count[v])};
   }
@@ -377,26 +381,32 @@ struct Optimizer {
     // Two passes, counting then filling: the array has its exact size (push_back's growth left
     // up to twice, at the optimiser's heap peak).
     // Ranges of todo on opt.n_threads threads, each with its own marks (the same lists).
-    const auto for_distinct = [&](std::vector<std::uint32_t>& marks, std::uint32_t stamp, std::int32_t v, auto&& f) {
+    const auto for_distinct = [&](Marks& marks, std::int32_t v, auto&& f) {
       for (std::int32_t k = start[v]; k < start[v + 1]; ++k)
-        for (std::int32_t u : tets[incident[k]])
-          if (u != v && marks[u] != stamp) marks[u] = stamp, f(u);
+        for (const std::int32_t u : tets[incident[k]]) {
+          std::uint64_t& word = marks.bits[static_cast<std::size_t>(u) >> 6];
+          const std::uint64_t bit = std::uint64_t{1} << (u & 63);
+          if (u == v || (word & bit)) continue;
+          word |= bit;
+          marks.set.push_back(u);
+          f(u);
+        }
+      for (const std::int32_t u : marks.set) marks.bits[static_cast<std::size_t>(u) >> 6] = 0;
+      marks.set.clear();
     };
     const auto ranges = [&](auto&& body) {
       if (nb_marks.empty()) nb_marks.resize(static_cast<std::size_t>(std::clamp(opt.n_threads, 1, 256)));
       std::atomic<std::size_t> slot{0};
       for_each_range(todo.size(), opt.n_threads, [&](std::size_t begin, std::size_t end) {
-        std::vector<std::uint32_t>& marks = nb_marks[slot++];
-        if (marks.empty()) marks.assign(n, std::numeric_limits<std::uint32_t>::max());
+        Marks& marks = nb_marks[slot++];
+        if (marks.bits.empty()) marks.bits.assign((n + 63) / 64, 0);
         body(marks, begin, end);
       });
     };
-    // (Node ids are below 2^31 - 1, so no stamp is the arrays' initial value.)
-    const auto stamp = [](std::int32_t v, std::uint32_t pass) { return 2 * static_cast<std::uint32_t>(v) + pass; };
-    ranges([&](std::vector<std::uint32_t>& marks, std::size_t begin, std::size_t end) {
+    ranges([&](Marks& marks, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         std::int32_t count = 0;
-        for_distinct(marks, stamp(todo[i], 0), todo[i], [&](std::int32_t) { ++count; });
+        for_distinct(marks, todo[i], [&](std::int32_t) { ++count; });
         nb_count[todo[i]] = count;
       }
     });
@@ -405,11 +415,11 @@ struct Optimizer {
     nb_blocks.emplace_back(new std::int32_t[std::max<std::size_t>(total, 1)]);
     std::int32_t* at = nb_blocks.back().get();
     for (const std::int32_t v : todo) nb_list[v] = at, at += nb_count[v];
-    ranges([&](std::vector<std::uint32_t>& marks, std::size_t begin, std::size_t end) {
+    ranges([&](Marks& marks, std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const std::int32_t v = todo[i];
         std::int32_t* out = nb_list[v];
-        for_distinct(marks, stamp(v, 1), v, [&](std::int32_t u) { *out++ = u; });
+        for_distinct(marks, v, [&](std::int32_t u) { *out++ = u; });
         sort_short(nb_list[v], out);
       }
     });
