@@ -564,9 +564,11 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   EdgeRemovalStats st;
   const std::size_t cap = 8 * todo.size() + 16;
   for (std::size_t round = 0; !todo.empty() && round < cap; ++round) {
-    const std::int32_t t = todo.top().second;
+    // Its quality as queued: a live tetrahedron's nodes neither move nor change here (the
+    // queue's value is q(t), computed once instead of up to three times a tetrahedron).
+    const auto [qt, t] = todo.top();
     todo.pop();
-    if (!w.alive[t] || !(w.q(t) > 0)) continue;
+    if (!w.alive[t] || !(qt > 0)) continue;
     const std::int32_t first_new = w.n_tets();
     const Tet nodes = w.tet(t);
     bool done = false;
@@ -575,10 +577,10 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
     // Concave surface swaps only here, where nothing else mends the tetrahedron: tried with the
     // others for every tetrahedron under below_deg they took elephant L4 from 21.42 to 18.03 deg
     // (its worst two then held surface edges of 0.0018-0.0019 among edges of 0.005-0.013).
-    if (!done && w.q(t) < concave_below)
+    if (!done && qt < concave_below)
       for (int i = 0; i < 4 && !done; ++i)
         for (int j = i + 1; j < 4 && !done; ++j) done = w.try_remove(nodes[i], nodes[j], st, true);
-    if (!done && w.q(t) < contract_below) {
+    if (!done && qt < contract_below) {
       // Its edges, shortest first (ties in the order of the removal loop above); each way round.
       std::array<std::pair<double, std::array<int, 2>>, 6> edges;
       int e = 0;
