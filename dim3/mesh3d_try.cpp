@@ -15,6 +15,7 @@
 #include "core/local_repair.hpp"
 #include "core/validate.hpp"
 #include "dim3/faults3d.hpp"
+#include "dim3/missed_surface.hpp"
 #include "dim3/quality_stage3d.hpp"
 #include "dim3/triangle_predicates.hpp"
 #include "dim3/untangle3d.hpp"
@@ -379,13 +380,38 @@ struct RepairLoop {
     if (!((topology_wrong || (smoothed && r.n_islands_dropped > 0)) && !islands_unresolvable)) return false;
     Flags flags(tree.n_leaves(), 0);
     std::size_t n_marked = 0;
-    for (std::size_t i = 0; i < tree.n_leaves(); ++i)
-      if (tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+    // With opt.topology_gap, a wrong Euler characteristic refines only the octants on the
+    // surface within reach of the surface the BE mesh misses.
+    std::size_t n_missed = 0;
+    if (topology_wrong && !empty && opt.topology_gap > 0) {
+      double finest = std::numeric_limits<double>::infinity();
+      for (std::size_t i = 0; i < tree.n_leaves(); ++i)
+        if (tm.sides[i] == Side::Partial) finest = std::min(finest, geometry(tree, tree.leaf(i)).extent()[0]);
+      const auto side_at = [&](const P3& p) {
+        const std::size_t i = locate(tree, p);
+        return i == no_leaf ? finest : geometry(tree, tree.leaf(i)).extent()[0];
+      };
+      const std::vector<MissedPoint> missed =
+          missed_surface(tm.fe.mesh, s, 0.5 * finest, [&](const P3& p) { return opt.topology_gap * side_at(p); });
+      n_missed = missed.size();
+      for (const MissedPoint& m : missed) {
+        Box<3> reach{m.p, m.p};
+        reach.lo.array() -= m.distance;
+        reach.hi.array() += m.distance;
+        for (const std::size_t i : leaves_in_box(tree, reach))
+          if (!flags[i] && tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+      }
+    }
+    if (n_marked == 0)
+      for (std::size_t i = 0; i < tree.n_leaves(); ++i)
+        if (tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
     if (n_marked == 0) return false;
     ++topology_refinements;
     ++r.n_repairs;
     say("repair " + std::to_string(attempt + 1) + ": refining the " + std::to_string(n_marked) +
-        " octants on the surface (" +
+        " octants on the surface" +
+        (n_missed > 0 ? " within reach of " + std::to_string(n_missed) + " point(s) of it the BE mesh misses" : std::string()) +
+        " (" +
         (empty            ? std::string("no interior octant: the solid is thinner than the octants everywhere")
          : topology_wrong ? "Euler characteristic " + std::to_string(*euler) + ", expected " +
                                 std::to_string(s.euler_characteristic() / 2)

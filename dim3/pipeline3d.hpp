@@ -149,6 +149,12 @@ struct Options3d {
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).
   int topology_refinements = 2;
+  /// Opt-in (0, the default: off). For a wrong Euler characteristic, refine only the octants on
+  /// the surface within reach of the surface the BE mesh misses (dim3/missed_surface.hpp:
+  /// samples farther from the interface triangles than this x the side of the octant they lie
+  /// in), and all of them only where no sample is that far. elephant L4 refines all 8,686 for
+  /// an Euler characteristic one off (-1, expected -2; 604,226 -> 1,146,084 tetrahedra).
+  double topology_gap = 0.0;
   /// Refinements around the octants dropped as islands, before the boundary octants are built:
   /// every leaf within `island_cells` of their size of an island octant is split, so that the
   /// thin part they sit in (elephant's legs, trunk, tail at level 4) gets interior octants that

@@ -218,7 +218,7 @@ constexpr const char* usage =
     "                        faces and each node's worst angles\n"
     "  --single              one try, no fallbacks           --nosnap  no feature snapping\n"
     "  --accept-folds --peel-rounds N --buffer B --flat-buffer B --max-level L --worse-repairs N --max-repairs N --island-refinements N\n"
-    "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N\n"
+    "  --island-cells C --island-max-fraction F --thin-cells C --topology-refinements N --topology-gap G\n"
     "  --extra-levels N --thickness-extra N --optimize-sweeps N --target-dihedral DEG --smooth N\n"
     "                        the Options3d fields of those names (dim3/pipeline3d.hpp)\n";
 
@@ -231,7 +231,7 @@ int option_values(const std::string& a) {
       {"--extra-levels", 1}, {"--facing", 1}, {"--feature-extra", 1}, {"--island-cells", 1},
       {"--island-max-fraction", 1}, {"--island-refinements", 1}, {"--max-repairs", 1}, {"--only", 1},
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
-      {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1},
+      {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1}, {"--topology-gap", 1},
       {"--graze-region", 0}, {"--graze-length", 1}, {"--root-shift", 3}, {"--repair-at-cells", 0},
       {"--untangle-reach", 1}, {"--backward-along", 1}};
   for (const auto& [name, n] : known)
@@ -332,6 +332,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--thin-cells") opt.thin_cells = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--island-max-fraction") opt.island_max_fraction = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--topology-refinements") opt.topology_refinements = std::atoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--topology-gap") opt.topology_gap = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--extra-levels") opt.extra_levels = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--thickness-extra") opt.thickness_extra_levels = std::atoi(argv[i + 1]);
     if (std::string(argv[i]) == "--optimize-sweeps") opt.optimize_sweeps = std::atoi(argv[i + 1]);
