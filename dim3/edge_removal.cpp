@@ -491,6 +491,10 @@ struct Work {
 EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocation>& where, std::vector<std::int32_t>* cell,
                                   const EdgeRemovalOptions& opt) {
   Work w{mesh, where, opt, 0, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, {}};
+  // The caller's node -> tetrahedra lists, taken (EdgeRemovalOptions::incidence): freed with
+  // this call whichever way it returns.
+  NodeTets handed;
+  if (opt.incidence) std::swap(handed, *opt.incidence);
   const std::size_t n = mesh.points.size();
   w.n_input = static_cast<std::int32_t>(mesh.solid.size());
   for (std::size_t e = 0; e < mesh.solid.size(); ++e)
@@ -531,18 +535,16 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
   std::vector<Entry> bad;
   for (const auto& b : bad_in) bad.insert(bad.end(), b.begin(), b.end());
   bad_in.clear();
-  if (bad.empty()) {
-    if (opt.incidence) opt.incidence->clear();
-    return {};
-  }
+  if (bad.empty()) return {};
   std::priority_queue<Entry, std::vector<Entry>, std::greater<>> todo(std::greater<>{}, std::move(bad));
   w.alive.assign(static_cast<std::size_t>(w.n_input), 1);
-  if (opt.incidence && opt.incidence->fits(n, static_cast<std::size_t>(w.n_input))) {
+  if (handed.fits(n, static_cast<std::size_t>(w.n_input))) {
     // (The optimiser's lists of the same tetrahedra: building them again was about 13 ms a
     // round on one thread and 19 on two at sphere966's 995,232 tetrahedra.)
-    w.at_start.swap(opt.incidence->start);
-    w.at_list.swap(opt.incidence->tets);
+    w.at_start.swap(handed.start);
+    w.at_list.swap(handed.tets);
   } else {
+    handed.clear();  // (lists of another mesh: not held beside the new ones)
     incidence_csr(
         n, static_cast<std::size_t>(w.n_input),
         [&](std::size_t e, auto&& f) {
@@ -550,7 +552,6 @@ EdgeRemovalStats remove_bad_edges(Mesh<3>& mesh, const std::vector<BoundaryLocat
         },
         opt.n_threads, w.at_start, w.at_list);
   }
-  if (opt.incidence) opt.incidence->clear();
   w.at_added.reset(n);
   w.node_faces.reset(n);
   w.node_dead.assign(n, 0);

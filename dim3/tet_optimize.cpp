@@ -683,6 +683,7 @@ double tet_min_dihedral_deg(const P3& a, const P3& b, const P3& c, const P3& d) 
 TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& where, const TetOptimizeOptions& opt) {
   Optimizer o{mesh, where, opt, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, {}, 0.0, 0.0};
   const std::size_t n = mesh.points.size();
+  if (opt.incidence) opt.incidence->clear();  // filled at the end, where the lists were made
   for (std::size_t e = 0; e < mesh.solid.size(); ++e) {
     MESH_ASSERT(mesh.solid.type[e] == ElemType::Tet4, "optimize_tets needs tetrahedra");
     MESH_ASSERT(mesh.solid.offset[e] == static_cast<std::int32_t>(4 * e), "element " << e << " is not at 4 e");
@@ -799,7 +800,6 @@ TetOptimizeStats optimize_tets(Mesh<3>& mesh, std::vector<BoundaryLocation>& whe
     st.inverted_after = st.inverted_before, st.min_dihedral_after_deg = st.min_dihedral_before_deg;
     st.folded_after = st.folded_before;
     if (opt.ranks) opt.ranks->swap(o.tet_q);
-    if (opt.incidence) opt.incidence->clear();
     return st;
   }
   if (opt.ranks) o.moved_tet.assign(o.tets.size(), 0);
