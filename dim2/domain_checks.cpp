@@ -190,13 +190,14 @@ std::vector<int> nesting_depths(const std::vector<Loop>& loops) {
   return depth;
 }
 
+double check_tolerance(const Box<2>& box) { return 1e-10 * box.extent().maxCoeff(); }
+
 double check_tolerance(const Domain& domain) {
   Box<2> box = Box<2>::empty();
   for (const Loop& l : domain.loops)
     for (const Bezier& q : l.pieces)
       for (const P2& p : q) box.expand(p);
-  const double size = domain.loops.empty() ? 0.0 : box.extent().maxCoeff();
-  return 1e-10 * size;
+  return domain.loops.empty() ? 0.0 : check_tolerance(box);
 }
 
 void check_domain(const Domain& domain) {

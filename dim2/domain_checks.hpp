@@ -32,6 +32,8 @@ std::vector<int> nesting_depths(const std::vector<Loop>& loops);
 
 /// The tolerance the checks use: 1e-10 of the domain's size.
 double check_tolerance(const Domain& domain);
+/// The same of a box's size (its largest extent): the SVG reader's check of every outline.
+double check_tolerance(const Box<2>& box);
 
 /// Throws InputError unless the domain is a valid solid description (see above).
 void check_domain(const Domain& domain);

@@ -377,8 +377,8 @@ class SvgReader {
         cands.push_back(std::move(c));
       }
     }
-    // The same tolerance as the curve kernel's checks (check_tolerance: 1e-10 of the size).
-    check_outlines(all, 1e-10 * box.extent().maxCoeff());
+    // The curve kernel's tolerance, of the drawing's size.
+    check_outlines(all, check_tolerance(box));
     // Which side of each subpath is solid? Just inside it the winding number of its shape is the
     // other subpaths' winding plus its own orientation; just outside, the others' alone. It
     // bounds the shape only if the fill rule fills one side and not the other; it bounds the
