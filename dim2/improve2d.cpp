@@ -7,7 +7,6 @@
 #include <limits>
 #include <optional>
 #include <span>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include "core/mesh_topology.hpp"
 #include "core/parallel_ranges.hpp"
 #include "core/partitioned_sweep.hpp"
+#include "core/radix_sort_lsd.hpp"
 #include "core/smooth.hpp"
 
 namespace febemesh::dim2 {
@@ -294,39 +294,6 @@ bool spans_parts(const std::vector<std::uint8_t>& part, std::int32_t a, std::int
   return part[static_cast<std::size_t>(b)] != p || part[static_cast<std::size_t>(c)] != p || part[static_cast<std::size_t>(d)] != p;
 }
 
-/// Sorts non-negative integer keys ascending: LSD radix by 11-bit digits, skipping a digit in
-/// which all keys agree (an edge key's two node ids leave the top bits of each half zero: 4
-/// passes of the 6 at 486,000 nodes). scratch is working space. The flip passes sort their
-/// unsure triangles and candidate edges every pass (NimbusSans U0067 at 10^6 triangles: 9
-/// passes, 123,000 triangles and 369,000 edges in all), where std::sort was 0.9% and 0.4% of
-/// the run's samples: this stage took 0.1658 s with std::sort and 0.1521 s with this (U0067;
-/// flange: 0.1306 and 0.1225 with the incidence's moved lists too; medians of 6 and 5
-/// alternating runs on one thread).
-template <class T> void radix_sort(std::vector<T>& keys, std::vector<T>& scratch) {
-  static_assert(std::is_integral_v<T>);
-  using U = std::make_unsigned_t<T>;
-  constexpr int bits = 11, n_digits = (8 * static_cast<int>(sizeof(T)) + bits - 1) / bits;
-  constexpr std::size_t radix = std::size_t{1} << bits;
-  const std::size_t n = keys.size();
-  if (n < 512) {  // the counts' set-up would outweigh the sort
-    std::sort(keys.begin(), keys.end());
-    return;
-  }
-  const auto digit = [](T k, int d) { return static_cast<std::size_t>((static_cast<U>(k) >> (d * bits)) & (radix - 1)); };
-  std::vector<std::uint32_t> count(n_digits * radix, 0);
-  for (const T k : keys)
-    for (int d = 0; d < n_digits; ++d) ++count[d * radix + digit(k, d)];
-  scratch.resize(n);
-  for (int d = 0; d < n_digits; ++d) {
-    std::uint32_t* c = count.data() + d * radix;
-    if (c[digit(keys[0], d)] == n) continue;  // all keys agree in this digit
-    std::uint32_t start = 0;
-    for (std::size_t b = 0; b < radix; ++b) start += std::exchange(c[b], start);
-    for (const T k : keys) scratch[c[digit(k, d)]++] = k;
-    keys.swap(scratch);
-  }
-}
-
 /// Local index k of triangle v with {v[k], v[k+1]} == {a, b}, or -1.
 int local_edge(const VertexId* v, std::int32_t a, std::int32_t b) {
   for (int k = 0; k < 3; ++k) {
@@ -499,7 +466,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
       candidates.clear();
-      radix_sort(unsure, unsure_scratch);
+      radix_sort_lsd(unsure, unsure_scratch);
       unsure.erase(std::unique(unsure.begin(), unsure.end()), unsure.end());
       std::size_t n_unsure = 0;
       for (const std::int32_t e : unsure) {
@@ -510,7 +477,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       }
       unsure.resize(n_unsure);
       if (candidates.empty()) break;
-      radix_sort(candidates, candidates_scratch);
+      radix_sort_lsd(candidates, candidates_scratch);
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       // Connectivity as at the start of the pass: a flipped triangle is `touched` and its edges
       // are skipped for the rest of the pass. Every candidate's flip is decided on the pass's
