@@ -241,13 +241,14 @@ class LiveIncidence {
     const std::int32_t* list = elem_.data() + first_[v];
     auto n = static_cast<std::size_t>(first_[v + 1] - first_[v]);
     while (n > 0 && list[n - 1] < 0) --n;
-    if (n == 0 && list[0] < -1) return moved_[static_cast<std::size_t>(-2 - list[0])];  // (every node has 2+ slots)
+    if (n == 0)  // (every node has 2+ slots)
+      if (const std::int32_t k = moved_index(list); k >= 0) return moved_[static_cast<std::size_t>(k)];
     return {list, n};
   }
   void add(std::int32_t v, std::int32_t e) {
     std::int32_t* list = elem_.data() + first_[v];
     const std::int32_t slots = first_[v + 1] - first_[v];
-    if (list[0] < -1) return moved_[static_cast<std::size_t>(-2 - list[0])].push_back(e);
+    if (const std::int32_t k = moved_index(list); k >= 0) return moved_[static_cast<std::size_t>(k)].push_back(e);
     for (std::int32_t k = 0; k < slots; ++k)
       if (list[k] < 0) return void(list[k] = e);
     moved_.emplace_back(list, list + slots).push_back(e);  // full: moved out
@@ -257,8 +258,8 @@ class LiveIncidence {
   /// Requires e in v's list.
   void remove(std::int32_t v, std::int32_t e) {
     std::int32_t* list = elem_.data() + first_[v];
-    if (list[0] < -1) {
-      std::vector<std::int32_t>& moved = moved_[static_cast<std::size_t>(-2 - list[0])];
+    if (const std::int32_t k = moved_index(list); k >= 0) {
+      std::vector<std::int32_t>& moved = moved_[static_cast<std::size_t>(k)];
       const auto it = std::find(moved.begin(), moved.end(), e);
       MESH_ASSERT(it != moved.end(), "element " << e << " not at node " << v);
       *it = moved.back();
@@ -277,6 +278,9 @@ class LiveIncidence {
   static constexpr std::int32_t spare = 2;
   std::vector<std::int32_t> first_, elem_;
   std::vector<std::vector<std::int32_t>> moved_;  ///< the lists that outgrew their slots
+  /// The index in moved_ of the list a node's slots (starting at `list`) hand over to, by the
+  /// mark in the first; -1 where they hold the list themselves.
+  static std::int32_t moved_index(const std::int32_t* list) { return list[0] < -1 ? -2 - list[0] : -1; }
 };
 
 /// The exact degrees of some elements, by element id (direct-mapped), for improve_mesh.

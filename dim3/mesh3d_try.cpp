@@ -380,6 +380,9 @@ struct RepairLoop {
     if (!((topology_wrong || (smoothed && r.n_islands_dropped > 0)) && !islands_unresolvable)) return false;
     Flags flags(tree.n_leaves(), 0);
     std::size_t n_marked = 0;
+    const auto mark_if_refinable = [&](std::size_t i) {
+      if (!flags[i] && tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+    };
     // With opt.topology_gap, a wrong Euler characteristic refines only the octants on the
     // surface within reach of the surface the BE mesh misses.
     std::size_t n_missed = 0;
@@ -398,13 +401,11 @@ struct RepairLoop {
         Box<3> reach{m.p, m.p};
         reach.lo.array() -= m.distance;
         reach.hi.array() += m.distance;
-        for (const std::size_t i : leaves_in_box(tree, reach))
-          if (!flags[i] && tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+        for (const std::size_t i : leaves_in_box(tree, reach)) mark_if_refinable(i);
       }
     }
     if (n_marked == 0)
-      for (std::size_t i = 0; i < tree.n_leaves(); ++i)
-        if (tm.sides[i] == Side::Partial && tree.leaf(i).level < max_level) flags[i] = 1, ++n_marked;
+      for (std::size_t i = 0; i < tree.n_leaves(); ++i) mark_if_refinable(i);
     if (n_marked == 0) return false;
     ++topology_refinements;
     ++r.n_repairs;
