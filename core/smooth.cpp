@@ -263,7 +263,10 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
   // Tetrahedra only: their states four at a time (tet_jacobians_n, the same numbers).
   const bool all_tets = Dim == 3 && std::all_of(mesh.solid.type.begin(), mesh.solid.type.end(),
                                                 [](ElemType t) { return t == ElemType::Tet4; });
-  for_each_range(mesh.solid.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
+  // Without min_quality, valid[e] == 2 until e's state is first read (fill_states).
+  const bool lazy = !options.min_quality;
+  if (lazy) std::fill(valid.begin(), valid.end(), std::uint8_t{2});
+  else for_each_range(mesh.solid.size(), options.n_threads, [&](std::size_t begin, std::size_t end) {
     if constexpr (Dim == 3) {
       if (all_tets) {
         constexpr std::size_t block = 256;
@@ -283,7 +286,15 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     }
     for (std::size_t e = begin; e < end; ++e) set_state(static_cast<std::int32_t>(e), element_state(static_cast<std::int32_t>(e)));
   });
-  stats.min_quality_before = min_quality();
+  if (!lazy) stats.min_quality_before = min_quality();
+  // The states of v's elements that no visit has read yet (lazy): a visit of v writes only the
+  // states of v's elements, so the sweeps' threads never evaluate the same one, and an element's
+  // stored state is always that of the current points (an accepted move rewrites the states of
+  // all the moved node's elements): the value the up-front pass would have left there.
+  const auto fill_states = [&](std::span<const std::int32_t> elems) {
+    for (const std::int32_t e : elems)
+      if (valid[static_cast<std::size_t>(e)] == 2) set_state(e, element_state(e));
+  };
   // settled[v]: 1 if v's target was where it stands, 2 if its move was rejected, and no node of
   // its elements has moved since; its target, its elements' states and the trial states would
   // be the same numbers, so the same outcome: it is skipped (and counted as before).
@@ -368,6 +379,7 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
 
     double old_min = std::numeric_limits<double>::infinity();
     std::size_t worst = 0;
+    if (lazy) fill_states(elems);
     for (std::size_t k = 0; k < elems.size(); ++k) {
       if (scaled[elems[k]] < old_min) worst = k;
       old_min = std::min(old_min, scaled[elems[k]]);
@@ -428,11 +440,18 @@ template <int Dim> SmoothStats smooth(Mesh<Dim>& mesh, const SmoothOptions<Dim>&
     else
       in_order->run(visit);
   }
+  if (options.at_rest) {
+    options.at_rest->clear();
+    if (gather) {  // settled's own storage (a copy was the 2D run's memory peak + 2 B/element)
+      for (std::uint8_t& s : settled) s = s == 1 ? 1 : 0;
+      *options.at_rest = std::move(settled);
+    }
+  }
   for (const PerThread& my : per_thread) {
     stats.moves_accepted += my.accepted;
     stats.moves_rejected += my.rejected;
   }
-  stats.min_quality_after = min_quality();
+  if (!lazy) stats.min_quality_after = min_quality();
   return stats;
 }
 

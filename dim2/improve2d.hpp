@@ -19,6 +19,13 @@
 
 namespace febemesh::dim2 {
 
+/// The quality pass's rounding share: a target within 1e-10 of v's longest edge from v is where v
+/// stands up to rounding (within_rounding). On a grid the centroid is the node itself but for a
+/// few ulps (1e-13 of an edge at level 10, 3e-11 at level 17); trying it cost the guard three
+/// steps at most of the nodes (flange, 5.4 M triangles). Such a node stays (it could at best
+/// gain ~1e-8 deg). The same test in improve_mesh and improve_mesh_ref.
+inline constexpr double quality_rounding_share = 1e-10;
+
 struct ImproveStats {
   std::size_t flips = 0;
   std::size_t moves = 0;
@@ -52,8 +59,14 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m);
 /// 2 is the same as 1. The per-element set-up, the mesh's smallest angle and the smoothing sweeps
 /// (in slabs, core/partitioned_sweep.hpp; `slide` must then be safe to call concurrently for
 /// different nodes) run on n_threads threads, the flips on one; the same mesh for every count.
+///
+/// `at_rest` (optional, a byte per node): SmoothOptions::at_rest of a smoothing with min_move at
+/// most quality_rounding_share that ended at m's points and elements; its free nodes at rest
+/// start settled, as their first visit would leave them. Taken over (left empty). The same
+/// mesh with it or without.
 ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
-                          const SlideFn& slide = {}, int n_threads = 1);
+                          const SlideFn& slide = {}, int n_threads = 1,
+                          std::vector<std::uint8_t>* at_rest = nullptr);
 /// Slow twin of improve_mesh (recomputes every angle, sorts all half-edges each pass): the same
 /// mesh, for tests.
 ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,

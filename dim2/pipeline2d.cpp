@@ -144,7 +144,10 @@ Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Pro
       so.parts = default_sweep_parts;
       // Rounding noise: a few ulps of the coordinates are ~1e-13 of an edge at level 10 and
       // ~3e-11 at level 17; real moves near the curve are far above it.
-      so.min_move = 1e-10;
+      so.min_move = quality_rounding_share;  // 1e-10; the quality pass's too (at_rest)
+      so.min_quality = false;  // (not reported)
+      std::vector<std::uint8_t> at_rest;
+      so.at_rest = &at_rest;
       so.fixed.assign(fe.mesh.points.size(), 0);
       if (opt.slide_boundary) {
         for (std::size_t k = 0; k < fe.where.size(); ++k)
@@ -187,7 +190,7 @@ Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Pro
       if (opt.improve_rounds > 0) {
         say("quality: edge flips and angle-guarded smoothing");
         lock_interface();
-        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide, opt.n_threads);
+        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide, opt.n_threads, &at_rest);
         settle_interface();
         r.n_flips = is.flips;
         clock.lap("quality pass");

@@ -227,3 +227,77 @@ TEST_CASE("smoothing's one-pass neighbour lists (one thread) = the counted ones 
     check_same_on_threads(start, opt, one, s1);
   }
 }
+
+TEMPLATE_TEST_CASE_SIG("states evaluated when first read move the points as the up-front ones; at_rest nodes are within rounding",
+                       "[smooth][threads]", ((int Dim), Dim), 2, 3) {
+  // Half the grid rough (0.3 cells), half off its centroids by rounding only (1e-13): most of
+  // the quiet half's nodes settle at their first visit, reading no state.
+  const int n = Dim == 2 ? 40 : 12;
+  for (const bool simplices : {false, true}) {
+    const Mesh<Dim> rough = perturbed<Dim>(n, simplices, 0.3, 13), quiet = perturbed<Dim>(n, simplices, 1e-13, 17);
+    Mesh<Dim> start = quiet;
+    for (std::size_t v = 0; v < start.points.size(); ++v)
+      if (start.points[v][0] < 0.5 * n) start.points[v] = rough.points[v];
+    // The 2D pipeline's options: every boundary node fixed, sweeps in parts, rounding share.
+    SmoothOptions<Dim> opt;
+    opt.fixed.assign(start.points.size(), 0);
+    for (std::size_t v = 0; v < start.points.size(); ++v) opt.fixed[v] = on_grid_boundary<Dim>(quiet.points[v], n);
+    opt.boundary_fixed = true;
+    opt.parts = 4;
+    opt.min_move = 1e-10;
+    for (const int threads : {1, 2}) {
+      CAPTURE(simplices, threads);
+      opt.n_threads = threads;
+      opt.min_quality = true;
+      opt.at_rest = nullptr;
+      Mesh<Dim> upfront = start;
+      const SmoothStats su = smooth(upfront, opt);
+      REQUIRE(su.moves_accepted > 0);
+      opt.min_quality = false;
+      std::vector<std::uint8_t> at_rest(3, 7);  // replaced
+      opt.at_rest = &at_rest;
+      Mesh<Dim> lazy = start;
+      const SmoothStats sl = smooth(lazy, opt);
+      CHECK(lazy.points == upfront.points);
+      CHECK(sl.moves_accepted == su.moves_accepted);
+      CHECK(sl.moves_rejected == su.moves_rejected);
+      CHECK(sl.min_quality_after == 0.0);  // not computed
+      if constexpr (Dim == 3) {
+        CHECK(at_rest.empty());  // neighbours from lists, not gathered from polygons
+      } else {
+        REQUIRE(at_rest.size() == lazy.points.size());
+        // Each node at rest: the centroid of its polygon neighbours (ascending) within rounding.
+        std::size_t n_rest = 0;
+        for (std::size_t v = 0; v < lazy.points.size(); ++v) {
+          CHECK(at_rest[v] <= 1);
+          if (at_rest[v] != 1) continue;
+          ++n_rest;
+          CHECK(!opt.fixed[v]);
+          std::vector<std::int32_t> nbrs;
+          for (std::size_t e = 0; e < lazy.solid.size(); ++e) {
+            const VertexId* ev = lazy.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+            const int m = lazy.solid.n_nodes_of(ElemId{static_cast<std::int32_t>(e)});
+            for (int k = 0; k < m; ++k)
+              if (ev[k].v == static_cast<std::int32_t>(v)) nbrs.push_back(ev[(k + 1) % m].v), nbrs.push_back(ev[(k + m - 1) % m].v);
+          }
+          std::sort(nbrs.begin(), nbrs.end());
+          nbrs.erase(std::unique(nbrs.begin(), nbrs.end()), nbrs.end());
+          Point<Dim> target = Point<Dim>::Zero();
+          for (const std::int32_t w : nbrs) target += lazy.points[static_cast<std::size_t>(w)];
+          target /= static_cast<double>(nbrs.size());
+          CHECK(within_rounding<Dim>(lazy.points, static_cast<std::int32_t>(v), nbrs, target, opt.min_move));
+        }
+        // Some: the rough half's moves spread over the sweeps and wake most of the quiet half.
+        const auto n_free = static_cast<std::size_t>(std::count(opt.fixed.begin(), opt.fixed.end(), 0));
+        CHECK(n_rest > 0);
+        CHECK(n_rest < n_free);
+        // All quiet: every free node at rest, none moved.
+        Mesh<Dim> still = quiet;
+        const SmoothStats sq = smooth(still, opt);
+        CHECK(sq.moves_accepted == 0);
+        CHECK(still.points == quiet.points);
+        CHECK(static_cast<std::size_t>(std::count(at_rest.begin(), at_rest.end(), 1)) == n_free);
+      }
+    }
+  }
+}

@@ -3,9 +3,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
+#include "core/partitioned_sweep.hpp"
+#include "core/smooth.hpp"
 #include "core/write_msh.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/improve2d.hpp"
@@ -109,6 +112,35 @@ TEST_CASE("the fast quality pass gives the mesh of its slow twin", "[pipeline2d]
       CHECK(a.min_angle_after == b.min_angle_after);
       CHECK(a.flips + a.moves > 0);  // the pass did something to compare
       CHECK(msh_string(fast) == msh_string(slow));
+    }
+    // Started from a smoothing's at_rest (the pipeline's): the same mesh as without it. One more
+    // smoothing (the pipeline's options) of the smoothed mesh, which leaves some nodes at rest
+    // (flange level 6: 480 of 3,554).
+    Mesh<2> smoothed = r.fe.mesh;
+    SmoothOptions<2> so;
+    so.parts = default_sweep_parts;
+    so.min_move = quality_rounding_share;
+    so.min_quality = false;
+    so.fixed.assign(smoothed.points.size(), 0);
+    for (const std::int32_t v : r.fe.where.nodes()) so.fixed[v] = 1;
+    so.boundary_fixed = true;
+    std::vector<std::uint8_t> at_rest;
+    so.at_rest = &at_rest;
+    smooth(smoothed, so);
+    REQUIRE(at_rest.size() == smoothed.points.size());
+    REQUIRE(std::count(at_rest.begin(), at_rest.end(), 1) > static_cast<std::ptrdiff_t>(smoothed.points.size() / 20));
+    for (const int threads : {1, 2}) {
+      INFO(threads << " threads, from at_rest");
+      Mesh<2> without = smoothed, with = smoothed;
+      CurveLocations where_without = r.fe.where, where_with = r.fe.where;
+      std::vector<std::uint8_t> given = at_rest;
+      const ImproveStats a = improve_mesh(without, locked, 4, slide_for(without, where_without), threads);
+      const ImproveStats b = improve_mesh(with, locked, 4, slide_for(with, where_with), threads, &given);
+      CHECK(given.empty());  // taken over
+      CHECK(a.flips == b.flips);
+      CHECK(a.moves == b.moves);
+      CHECK(a.min_angle_after == b.min_angle_after);
+      CHECK(msh_string(with) == msh_string(without));
     }
   }
 }
