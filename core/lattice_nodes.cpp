@@ -73,6 +73,77 @@ void radix_sort(std::vector<std::uint64_t>& keys, int n_threads) {
   });
 }
 
+/// Ranges of at most this many keys go from the MSD partitions to LSD passes in a scratch
+/// buffer of this size (128 KiB: in L2).
+constexpr std::size_t lsd_max_keys = std::size_t(1) << 14;
+
+/// Sorts [first, last) by the bits at `low` and above (low a multiple of 8; ties in any order),
+/// where the keys agree above the byte at `shift`: MSD partitions while a range has more than
+/// lsd_max_keys keys, then one LSD pass a byte from `low` up to `shift` (a byte in which the
+/// range agrees is skipped), short ranges by insertion.
+void sort_above(std::uint64_t* first, std::uint64_t* last, int shift, int low, std::vector<std::uint64_t>& scratch) {
+  const auto n = static_cast<std::size_t>(last - first);
+  if (n < 2 || shift < low) return;
+  if (n <= 32) {
+    for (std::uint64_t* i = first + 1; i < last; ++i) {
+      const std::uint64_t k = *i;
+      std::uint64_t* j = i;
+      for (; j > first && (*(j - 1) >> low) > (k >> low); --j) *j = *(j - 1);
+      *j = k;
+    }
+    return;
+  }
+  if (n > lsd_max_keys) {
+    const auto start = partition_by_byte(first, last, shift);
+    for (std::size_t b = 0; b < 256; ++b) sort_above(first + start[b], first + start[b + 1], shift - 8, low, scratch);
+    return;
+  }
+  const int n_bytes = (shift - low) / 8 + 1;
+  std::array<std::array<std::uint32_t, 256>, 8> count;
+  for (int d = 0; d < n_bytes; ++d) count[d].fill(0);
+  for (const std::uint64_t* p = first; p != last; ++p)
+    for (int d = 0; d < n_bytes; ++d) ++count[d][(*p >> (low + 8 * d)) & 0xffu];
+  scratch.resize(lsd_max_keys);
+  std::uint64_t* from = first;
+  std::uint64_t* to = scratch.data();
+  for (int d = 0; d < n_bytes; ++d) {
+    std::array<std::uint32_t, 256>& c = count[d];
+    if (c[(*from >> (low + 8 * d)) & 0xffu] == n) continue;  // all keys agree in this byte
+    std::uint32_t at = 0;
+    for (std::uint32_t& x : c) at += std::exchange(x, at);
+    for (std::size_t i = 0; i < n; ++i) to[c[(from[i] >> (low + 8 * d)) & 0xffu]++] = from[i];
+    std::swap(from, to);
+  }
+  if (from != first) std::copy(from, from + n, first);
+}
+
+/// Sorts `keys` by their bits at `low` and above (low a multiple of 8; ties in any order, so
+/// the bits below `low` may be anything): sort_above from the highest byte in which they
+/// differ. On several threads as radix_sort.
+void radix_sort_above(std::vector<std::uint64_t>& keys, int low, int n_threads) {
+  std::uint64_t any = 0, all = ~std::uint64_t{0};
+  for (const std::uint64_t k : keys) any |= k, all &= k;
+  int shift = 56;
+  while (shift > low && (((any ^ all) >> shift) & 0xffu) == 0) shift -= 8;
+  std::uint64_t* const first = keys.data();
+  if (n_threads <= 1 || keys.size() < (std::size_t(1) << 16)) {
+    std::vector<std::uint64_t> scratch;
+    sort_above(first, first + keys.size(), shift, low, scratch);
+    return;
+  }
+  const auto start = partition_by_byte(first, first + keys.size(), shift);
+  const std::size_t n_parts = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 64));
+  std::vector<std::size_t> part_first(n_parts + 1, 256);
+  for (std::size_t p = 0; p < n_parts; ++p)
+    part_first[p] = static_cast<std::size_t>(
+        std::lower_bound(start.begin(), start.begin() + 256, p * keys.size() / n_parts) - start.begin());
+  for_each_range(n_parts, n_threads, [&](std::size_t p0, std::size_t p1) {
+    std::vector<std::uint64_t> scratch;
+    for (std::size_t b = part_first[p0]; b < part_first[p1]; ++b)
+      sort_above(first + start[b], first + start[b + 1], shift - 8, low, scratch);
+  });
+}
+
 /// LimitError when n nodes would not have 32-bit ids.
 void check_node_ids(std::size_t n) {
   if (n > std::size_t(std::numeric_limits<std::int32_t>::max()))
@@ -102,6 +173,8 @@ bool sort_with_corners(const Orthtree<Dim>& t, const Kept& kept, std::size_t run
   const int place_bits = std::bit_width(n_leaves * n_corners - 1);
   if (width + place_bits > 64) return false;
   const std::uint64_t place_mask = place_bits == 64 ? ~std::uint64_t{0} : (std::uint64_t(1) << place_bits) - 1;
+  // The key part from a byte boundary on when it fits (the sort then reads whole bytes of it).
+  const int place_shift = width + (place_bits + 7) / 8 * 8 <= 64 ? (place_bits + 7) / 8 * 8 : place_bits;
   const std::uint64_t part_mask = width == 64 ? ~std::uint64_t{0} : (std::uint64_t(1) << width) - 1;
   // Pack in place: run c of leaves (as the keys were written) holds its kept leaves' corners
   // from run_start[c] * n_corners on, in leaf order.
@@ -113,14 +186,15 @@ bool sort_with_corners(const Orthtree<Dim>& t, const Kept& kept, std::size_t run
         continue;
       }
       for (int k = 0; k < n_corners; ++k, ++at)
-        *at = (((*at >> low) & part_mask) << place_bits) | static_cast<std::uint64_t>(i * n_corners + static_cast<std::size_t>(k));
+        *at = (((*at >> low) & part_mask) << place_shift) | static_cast<std::uint64_t>(i * n_corners + static_cast<std::size_t>(k));
     }
   });
-  radix_sort(keys, n_threads);
+  // By the key part only: the order of a node's corners among themselves changes nothing below.
+  radix_sort_above(keys, place_shift / 8 * 8, n_threads);
   // Node ids in key order: a chunk's first node id is the count of distinct keys before it.
   const std::size_t n_keys = keys.size();
   const std::size_t chunk = chunk_size(n_keys, n_threads, std::size_t(1) << 16);
-  const auto starts_node = [&](std::size_t j) { return j == 0 || (keys[j] >> place_bits) != (keys[j - 1] >> place_bits); };
+  const auto starts_node = [&](std::size_t j) { return j == 0 || (keys[j] >> place_shift) != (keys[j - 1] >> place_shift); };
   const std::vector<std::size_t> first_id =
       chunk_starts(n_keys, chunk, n_threads, std::size_t{0}, [&](std::size_t begin, std::size_t end) {
         std::size_t k = 0;
@@ -135,7 +209,7 @@ bool sort_with_corners(const Orthtree<Dim>& t, const Kept& kept, std::size_t run
   for_each_chunk(n_keys, chunk, n_threads, [&](std::size_t c, std::size_t begin, std::size_t end) {
     std::size_t id = first_id[c];  // the id of the next new key
     for (std::size_t j = begin; j < end; ++j) {
-      if (starts_node(j)) nodes.points[id++] = point_from_key<Dim>(fixed | ((keys[j] >> place_bits) << low));
+      if (starts_node(j)) nodes.points[id++] = point_from_key<Dim>(fixed | ((keys[j] >> place_shift) << low));
       const std::uint64_t place = keys[j] & place_mask;
       nodes.leaf_corners[place / n_corners][place % n_corners] = static_cast<std::int32_t>(id - 1);
     }

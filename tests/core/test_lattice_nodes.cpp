@@ -80,9 +80,22 @@ TEMPLATE_TEST_CASE_SIG("lattice_nodes: the kept corners sorted by key, on any th
     for (int d = 0; d < Dim; ++d) at_origin = at_origin && c.anchor[d] == 0;
     return c.level < 2 || at_origin;
   }));
+  // And one refined deep inside one level-5 cell only: its keys agree in their highest varying
+  // byte and more, so the sort partitions that bucket again before its LSD passes (over 2^14
+  // keys in one range).
+  Cell<Dim> deep;
+  deep.level = 5;
+  for (int d = 0; d < Dim; ++d) deep.anchor[d] = 11u * length(deep);
+  const auto c = balance_2to1(refine_while<Dim>(Orthtree<Dim>(), [&](const Cell<Dim>& x) {
+    bool overlaps = true;
+    for (int d = 0; d < Dim; ++d)
+      overlaps = overlaps && x.anchor[d] < deep.anchor[d] + length(deep) && deep.anchor[d] < x.anchor[d] + length(x);
+    return x.level < 3 || (overlaps && x.level < (Dim == 2 ? 12 : 9));
+  }));
   REQUIRE(a.n_leaves() * Cube<Dim>::n_corners > (std::size_t(1) << 16));
   REQUIRE(b.leaf(0).level == max_level<Dim>);
-  for (const Orthtree<Dim>* t : {&a, &b}) {
+  REQUIRE(c.n_leaves() * Cube<Dim>::n_corners > (std::size_t(1) << 15));
+  for (const Orthtree<Dim>* t : {&a, &b, &c}) {
     Flags keep(t->n_leaves());
     for (std::size_t i = 0; i < t->n_leaves(); ++i) keep[i] = i % 5 != 2;
     const auto [points, corners] = nodes_by_brute_force(*t, keep);
