@@ -35,44 +35,6 @@ std::array<std::size_t, 257> partition_by_byte(std::uint64_t* first, std::uint64
   return start;
 }
 
-/// Sorts [first, last) ascending: in-place MSD radix sort on the byte at `shift` and below,
-/// short ranges by std::sort. Linear in practice and no scratch buffer (this runs at the
-/// boundary stage's memory peak).
-void radix_sort(std::uint64_t* first, std::uint64_t* last, int shift) {
-  if (last - first < 64 || shift < 0) {
-    std::sort(first, last);
-    return;
-  }
-  const auto start = partition_by_byte(first, last, shift);
-  for (std::size_t b = 0; b < 256; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
-}
-
-/// Sorts `keys` ascending, starting at the highest byte in which they differ. On several
-/// threads the first byte's pass runs on the caller and its buckets spread over the threads
-/// (a sort: the same keys for every count).
-void radix_sort(std::vector<std::uint64_t>& keys, int n_threads) {
-  std::uint64_t any = 0, all = ~std::uint64_t{0};
-  for (const std::uint64_t k : keys) any |= k, all &= k;
-  int shift = 56;
-  while (shift > 0 && (((any ^ all) >> shift) & 0xffu) == 0) shift -= 8;
-  std::uint64_t* const first = keys.data();
-  if (n_threads <= 1 || keys.size() < (std::size_t(1) << 16)) {
-    radix_sort(first, first + keys.size(), shift);
-    return;
-  }
-  const auto start = partition_by_byte(first, first + keys.size(), shift);
-  // The buckets in runs of about equal numbers of keys (buckets are uneven: a tree's corners
-  // crowd where it is fine), four runs a thread.
-  const std::size_t n_parts = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 64));
-  std::vector<std::size_t> part_first(n_parts + 1, 256);
-  for (std::size_t p = 0; p < n_parts; ++p)
-    part_first[p] = static_cast<std::size_t>(
-        std::lower_bound(start.begin(), start.begin() + 256, p * keys.size() / n_parts) - start.begin());
-  for_each_range(n_parts, n_threads, [&](std::size_t p0, std::size_t p1) {
-    for (std::size_t b = part_first[p0]; b < part_first[p1]; ++b) radix_sort(first + start[b], first + start[b + 1], shift - 8);
-  });
-}
-
 /// Ranges of at most this many keys go from the MSD partitions to LSD passes in a scratch
 /// buffer of this size (128 KiB: in L2).
 constexpr std::size_t lsd_max_keys = std::size_t(1) << 14;
@@ -118,8 +80,10 @@ void sort_above(std::uint64_t* first, std::uint64_t* last, int shift, int low, s
 }
 
 /// Sorts `keys` by their bits at `low` and above (low a multiple of 8; ties in any order, so
-/// the bits below `low` may be anything): sort_above from the highest byte in which they
-/// differ. On several threads as radix_sort.
+/// the bits below `low` may be anything; low = 0: ascending), sort_above from the highest byte
+/// in which they differ. On several threads the first byte's pass runs on the caller and its
+/// buckets spread over the threads (a sort: the same keys for every count). In place but for a
+/// 128 KiB buffer a thread: this runs at the boundary stage's memory peak.
 void radix_sort_above(std::vector<std::uint64_t>& keys, int low, int n_threads) {
   std::uint64_t any = 0, all = ~std::uint64_t{0};
   for (const std::uint64_t k : keys) any |= k, all &= k;
@@ -132,6 +96,8 @@ void radix_sort_above(std::vector<std::uint64_t>& keys, int low, int n_threads) 
     return;
   }
   const auto start = partition_by_byte(first, first + keys.size(), shift);
+  // The buckets in runs of about equal numbers of keys (buckets are uneven: a tree's corners
+  // crowd where it is fine), four runs a thread.
   const std::size_t n_parts = 4 * static_cast<std::size_t>(std::clamp(n_threads, 1, 64));
   std::vector<std::size_t> part_first(n_parts + 1, 256);
   for (std::size_t p = 0; p < n_parts; ++p)
@@ -224,7 +190,7 @@ void sort_then_search(const Orthtree<Dim>& t, const Kept& kept, std::vector<std:
                       int n_threads) {
   constexpr int n_corners = Cube<Dim>::n_corners;
   const std::size_t n_leaves = t.n_leaves();
-  radix_sort(keys, n_threads);
+  radix_sort_above(keys, 0, n_threads);
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   check_node_ids(keys.size());
 
