@@ -183,7 +183,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
                       return worst;
                     }));
   };
-  st.worst_before = mesh_worst();
+  if (opt.measure_worst) st.worst_before = mesh_worst();
   // The worst cached q around v; at least the target when all of v's elements are clearly
   // above it (then v is skipped, as with their exact q).
   auto cached_worst = [&](std::size_t v) {
@@ -300,7 +300,7 @@ AngleOptimiseStats optimise_angles(Mesh<2>& m, const std::vector<std::uint8_t>& 
     st.moves += moved_this_round;
     if (moved_this_round == 0) break;
   }
-  st.worst_after = mesh_worst();
+  if (opt.measure_worst) st.worst_after = mesh_worst();
   return st;
 }
 

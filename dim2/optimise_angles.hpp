@@ -38,12 +38,16 @@ struct AngleOptimiseOptions {
   /// core/partitioned_sweep.hpp; `slide` and curve_distance must then be safe to call
   /// concurrently for different nodes); the same mesh for every count.
   int n_threads = 1;
+  /// Fill AngleOptimiseStats::worst_before and worst_after: two passes over the elements
+  /// (most of them by their largest corner cotangent); the mesh is the same without. (The 2D
+  /// pipeline does not report them.)
+  bool measure_worst = true;
 };
 
 struct AngleOptimiseStats {
   std::size_t moves = 0;
   double worst_before = 0.0;  ///< smallest q over the mesh (triangles scaled by target / triangle_target when set)
-  double worst_after = 0.0;
+  double worst_after = 0.0;   ///< (both 0 without AngleOptimiseOptions::measure_worst)
 };
 
 /// `locked` as in improve_mesh: 0 free, 1 fixed, 2 interface node that slides through `slide`.

@@ -214,6 +214,7 @@ Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Pro
         if (opt.elements == ElementKind::Mixed) ao.triangle_target = 1.5;
         ao.curve_distance = [&](const Point<2>& p) { return curve.closest_point(p).distance; };
         ao.n_threads = opt.n_threads;
+        ao.measure_worst = false;  // (not reported)
         r.n_angle_moves = optimise_angles(fe.mesh, locked, ao, slide).moves;
         settle_interface();
         clock.lap("angle optimisation");

@@ -84,6 +84,15 @@ TEST_CASE("a badly placed interior node is moved until every quad is within [30,
   CHECK(validate<2>(m).inverted == 0);
   for (std::size_t v = 0; v < m.points.size(); ++v)
     if (locked[v]) CHECK(m.points[v] == before.points[v]);
+  // Without measure_worst: the same points, no worst reported.
+  Mesh<2> unmeasured = before;
+  AngleOptimiseOptions ao;
+  ao.measure_worst = false;
+  const AngleOptimiseStats su = optimise_angles(unmeasured, locked, ao);
+  CHECK(unmeasured.points == m.points);
+  CHECK(su.moves == st.moves);
+  CHECK(su.worst_before == 0.0);
+  CHECK(su.worst_after == 0.0);
 }
 
 namespace {
