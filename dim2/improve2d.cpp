@@ -338,8 +338,10 @@ InterfaceNeighbours interface_neighbours(const Mesh<2>& m) {
   return out;
 }
 
-ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds, const SlideFn& slide,
-                          int n_threads, std::vector<std::uint8_t>* at_rest) {
+ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, const ImproveOptions& opt) {
+  const int rounds = opt.rounds, n_threads = opt.n_threads;
+  const SlideFn& slide = opt.slide;
+  std::vector<std::uint8_t>* const at_rest = opt.at_rest;
   ImproveStats st;
   const std::size_t n_nodes = m.points.size();
   constexpr double unknown = std::numeric_limits<double>::quiet_NaN();
@@ -385,7 +387,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       return !std::isfinite(cot[e]) || !(top - cot[e] > band) ? exact(e) : 180.0;
     }));
   };
-  st.min_angle_before = mesh_min();
+  if (opt.measure_min) st.min_angle_before = mesh_min();
 
   // Interface edges never flip (sorted keys, binary search).
   using EdgeKey = std::uint64_t;
@@ -694,7 +696,7 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, i
       w.unsure.clear();
     }
   }
-  st.min_angle_after = mesh_min();
+  if (opt.measure_min) st.min_angle_after = mesh_min();
   return st;
 }
 

@@ -29,8 +29,8 @@ inline constexpr double quality_rounding_share = 1e-10;
 struct ImproveStats {
   std::size_t flips = 0;
   std::size_t moves = 0;
-  double min_angle_before = 0.0;  ///< degrees, over all solid elements
-  double min_angle_after = 0.0;
+  double min_angle_before = 0.0;  ///< degrees, over all solid elements (measure_min)
+  double min_angle_after = 0.0;   ///< (both 0 without ImproveOptions::measure_min)
 };
 
 /// Smallest corner angle (degrees) of a triangle or quadrilateral; <= 0 when inverted.
@@ -54,19 +54,27 @@ struct InterfaceNeighbours {
 };
 InterfaceNeighbours interface_neighbours(const Mesh<2>& m);
 
+struct ImproveOptions {
+  int rounds = 4;  ///< flip passes then a smoothing sweep, this many times
+  /// Moves interface nodes (locked 2) along the curve; without, they stay as locked 1.
+  SlideFn slide;
+  /// The per-element set-up, the mesh's smallest angle and the smoothing sweeps (in slabs,
+  /// core/partitioned_sweep.hpp; `slide` must then be safe to call concurrently for different
+  /// nodes) run on n_threads threads, the flips on one; the same mesh for every count.
+  int n_threads = 1;
+  /// Optional, a byte per node: SmoothOptions::at_rest of a smoothing with min_move at most
+  /// quality_rounding_share that ended at m's points and elements; its free nodes at rest start
+  /// settled, as their first visit would leave them. Taken over (left empty). The same mesh with
+  /// it or without.
+  std::vector<std::uint8_t>* at_rest = nullptr;
+  /// Fill ImproveStats::min_angle_before and _after (two passes over the elements); the mesh is
+  /// the same without. (The 2D pipeline does not report them.)
+  bool measure_min = true;
+};
+
 /// `locked[v]`: 0 free, 1 never moves (corners), 2 interface node that may slide along the curve
-/// through `slide` (toward the midpoint of its two interface neighbours); without `slide`,
-/// 2 is the same as 1. The per-element set-up, the mesh's smallest angle and the smoothing sweeps
-/// (in slabs, core/partitioned_sweep.hpp; `slide` must then be safe to call concurrently for
-/// different nodes) run on n_threads threads, the flips on one; the same mesh for every count.
-///
-/// `at_rest` (optional, a byte per node): SmoothOptions::at_rest of a smoothing with min_move at
-/// most quality_rounding_share that ended at m's points and elements; its free nodes at rest
-/// start settled, as their first visit would leave them. Taken over (left empty). The same
-/// mesh with it or without.
-ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,
-                          const SlideFn& slide = {}, int n_threads = 1,
-                          std::vector<std::uint8_t>* at_rest = nullptr);
+/// through opt.slide (toward the midpoint of its two interface neighbours).
+ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, const ImproveOptions& opt = {});
 /// Slow twin of improve_mesh (recomputes every angle, sorts all half-edges each pass): the same
 /// mesh, for tests.
 ImproveStats improve_mesh_ref(Mesh<2>& m, const std::vector<std::uint8_t>& locked, int rounds = 4,

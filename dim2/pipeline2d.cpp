@@ -190,7 +190,13 @@ Result2d mesh2d_once(const CurveBoundary& curve, const Options2d& opt, const Pro
       if (opt.improve_rounds > 0) {
         say("quality: edge flips and angle-guarded smoothing");
         lock_interface();
-        const ImproveStats is = improve_mesh(fe.mesh, locked, opt.improve_rounds, slide, opt.n_threads, &at_rest);
+        ImproveOptions io;
+        io.rounds = opt.improve_rounds;
+        io.slide = slide;
+        io.n_threads = opt.n_threads;
+        io.at_rest = &at_rest;
+        io.measure_min = false;  // (not reported)
+        const ImproveStats is = improve_mesh(fe.mesh, locked, io);
         settle_interface();
         r.n_flips = is.flips;
         clock.lap("quality pass");
