@@ -470,9 +470,18 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
     double cot0 = 0.0, cot1 = 0.0;
   };
   std::vector<FlipPlan> plans;
+  // Candidates a pass decided not to flip (sorted), and the nodes of that pass's flips: no node
+  // moves between a round's flip passes, so the next pass would decide the same for such an edge
+  // unless a flip rewrote one of its triangles, which then had both its ends among the flip's
+  // four nodes. Those edges are not decided again (NimbusSans U0067 at 10^6 triangles, one
+  // thread, three alternating rounds: this stage 0.124-0.132 s -> 0.115-0.124).
+  std::vector<EdgeKey> kept_edges;
+  std::vector<std::uint8_t> flip_node(n_nodes, 0), known;
+  std::vector<std::int32_t> last_flip_nodes;
   std::optional<PartitionedSweep> sweep;
   bool new_separators = false;
   for (int round = 0; round < rounds; ++round) {
+    kept_edges.clear();  // (the sweep below moved nodes)
     // ---- flips: triangles only; repeat passes until none improves ----
     for (int pass = 0; pass < 8; ++pass) {
       candidates.clear();
@@ -499,10 +508,17 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
       // 145 ms at flange 1e6, on one thread or two.)
       flipped.clear();  // (touched is all 0 here: the last pass cleared what it set)
       plans.assign(candidates.size(), FlipPlan{});
+      known.assign(candidates.size(), 0);
+      for (std::size_t i = 0, j = 0; i < candidates.size() && j < kept_edges.size(); ++i) {
+        while (j < kept_edges.size() && kept_edges[j] < candidates[i]) ++j;
+        if (j == kept_edges.size() || kept_edges[j] != candidates[i]) continue;
+        known[i] = !flip_node[candidates[i] >> 32] || !flip_node[candidates[i] & 0xffffffffu];
+      }
       std::atomic<std::size_t> next_memo{0};
       for_each_range(candidates.size(), n_threads, [&](std::size_t i0, std::size_t i1) {
         Memo& memo = workers[next_memo++].memo;  // a cache: any thread's, one thread at a time
         for (std::size_t i = i0; i < i1; ++i) {
+          if (known[i]) continue;  // no flip, as the last pass decided
           const EdgeKey key = candidates[i];
           const auto lo = static_cast<std::int32_t>(key >> 32), hi = static_cast<std::int32_t>(key & 0xffffffffu);
           std::int32_t pair[2];
@@ -570,6 +586,14 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
       // Only the flipped triangles were touched: clearing them, not the whole array (a pass
       // over every element, up to 8 passes a round).
       for (const auto& f : flipped) touched[static_cast<std::size_t>(f[0])] = touched[static_cast<std::size_t>(f[1])] = 0;
+      // This pass's edges without a flip, and its flips' nodes, for the next pass.
+      kept_edges.clear();
+      for (std::size_t i = 0; i < candidates.size(); ++i)
+        if (plans[i].flip[0] < 0) kept_edges.push_back(candidates[i]);
+      for (const std::int32_t v : last_flip_nodes) flip_node[static_cast<std::size_t>(v)] = 0;
+      last_flip_nodes.clear();
+      for (const auto& f : flipped)
+        for (int k = 2; k < 6; ++k) flip_node[static_cast<std::size_t>(f[k])] = 1, last_flip_nodes.push_back(f[k]);
       // (c, a, d) lost b and gained d; (d, b, c) lost a and gained c.
       for (const auto& [e0, e1, a, b, c, d] : flipped) {
         incident.remove(b, e0), incident.remove(a, e1);
