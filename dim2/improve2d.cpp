@@ -477,7 +477,6 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
   // thread, three alternating rounds: this stage 0.124-0.132 s -> 0.115-0.124).
   std::vector<EdgeKey> kept_edges;
   std::vector<std::uint8_t> flip_node(n_nodes, 0), known;
-  std::vector<std::int32_t> last_flip_nodes;
   std::optional<PartitionedSweep> sweep;
   bool new_separators = false;
   for (int round = 0; round < rounds; ++round) {
@@ -506,14 +505,20 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
       // of theirs, and the serial loop skips those too, by `touched` or by finding not two
       // triangles on the edge. The decisions were all on the caller's thread: 36 of this stage's
       // 145 ms at flange 1e6, on one thread or two.)
-      flipped.clear();  // (touched is all 0 here: the last pass cleared what it set)
-      plans.assign(candidates.size(), FlipPlan{});
+      // The last pass's flips (still in `flipped`) mark their nodes while the kept edges are
+      // matched.
       known.assign(candidates.size(), 0);
+      for (const auto& f : flipped)
+        for (int k = 2; k < 6; ++k) flip_node[static_cast<std::size_t>(f[k])] = 1;
       for (std::size_t i = 0, j = 0; i < candidates.size() && j < kept_edges.size(); ++i) {
         while (j < kept_edges.size() && kept_edges[j] < candidates[i]) ++j;
         if (j == kept_edges.size() || kept_edges[j] != candidates[i]) continue;
         known[i] = !flip_node[candidates[i] >> 32] || !flip_node[candidates[i] & 0xffffffffu];
       }
+      for (const auto& f : flipped)
+        for (int k = 2; k < 6; ++k) flip_node[static_cast<std::size_t>(f[k])] = 0;
+      flipped.clear();  // (touched is all 0 here: the last pass cleared what it set)
+      plans.assign(candidates.size(), FlipPlan{});
       std::atomic<std::size_t> next_memo{0};
       for_each_range(candidates.size(), n_threads, [&](std::size_t i0, std::size_t i1) {
         Memo& memo = workers[next_memo++].memo;  // a cache: any thread's, one thread at a time
@@ -586,14 +591,10 @@ ImproveStats improve_mesh(Mesh<2>& m, const std::vector<std::uint8_t>& locked, c
       // Only the flipped triangles were touched: clearing them, not the whole array (a pass
       // over every element, up to 8 passes a round).
       for (const auto& f : flipped) touched[static_cast<std::size_t>(f[0])] = touched[static_cast<std::size_t>(f[1])] = 0;
-      // This pass's edges without a flip, and its flips' nodes, for the next pass.
+      // This pass's edges without a flip, for the next pass.
       kept_edges.clear();
       for (std::size_t i = 0; i < candidates.size(); ++i)
         if (plans[i].flip[0] < 0) kept_edges.push_back(candidates[i]);
-      for (const std::int32_t v : last_flip_nodes) flip_node[static_cast<std::size_t>(v)] = 0;
-      last_flip_nodes.clear();
-      for (const auto& f : flipped)
-        for (int k = 2; k < 6; ++k) flip_node[static_cast<std::size_t>(f[k])] = 1, last_flip_nodes.push_back(f[k]);
       // (c, a, d) lost b and gained d; (d, b, c) lost a and gained c.
       for (const auto& [e0, e1, a, b, c, d] : flipped) {
         incident.remove(b, e0), incident.remove(a, e1);
