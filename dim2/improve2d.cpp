@@ -184,15 +184,13 @@ namespace {
 /// with it and 0.1658 without, medians of 6 alternating runs on one thread.)
 class LiveIncidence {
  public:
-  explicit LiveIncidence(const Mesh<2>& m, int n_threads = 1) { rebuild(m, n_threads); }
   /// The lists add() would make of the elements in increasing order (each list ascending, then
   /// its spare slots), filled from the back: first_[v] starts at the end of v's uses and steps
   /// down to its start, one store a use instead of add's search for the first free slot.
   /// On n_threads threads, each owning a range of nodes and reading every element for them
   /// (the same lists; the serial build was most of this stage's set-up, 0.08 s of 0.13 at
   /// flange 1e6).
-  void rebuild(const Mesh<2>& m, int n_threads = 1) {
-    moved_.clear();
+  explicit LiveIncidence(const Mesh<2>& m, int n_threads = 1) {
     const std::size_t n = m.points.size();
     reserve_huge(first_, n + 1, n_threads);
     first_.resize(n + 1);
