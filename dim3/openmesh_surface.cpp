@@ -1,9 +1,14 @@
-// The OpenMesh adapter (STYLE.md §9): STL, OBJ and PLY are read with OpenMesh and handed on as a
-// plain TriangleSoup. OpenMesh refuses faces that would make an edge non-manifold and drops
-// them with a warning, so the face count is compared with what the file declares.
-
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+// The OpenMesh adapter (STYLE.md §9): STL, OBJ and PLY are parsed by OpenMesh's readers into a
+// plain TriangleSoup through an importer of our own (SoupImporter), not into an OpenMesh mesh:
+// its halfedge kernel refuses a face whose winding runs an edge the way a neighbour already
+// runs it ("complex edge") and splits vertices to stay manifold, so a closed surface whose
+// triangles are not consistently wound (Gmsh's STL export of OpenCASCADE solids winds each
+// face by its own parametrisation) came out with boundary edges and was refused as "not
+// closed". The soup keeps every face as the file gives it; validate_surface names what is
+// wrong and orients what is only wound inconsistently. The face count is still compared with
+// what the file declares (faces a reader itself skips).
+#include <OpenMesh/Core/IO/IOManager.hh>
+#include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <algorithm>
@@ -20,7 +25,87 @@ namespace febemesh::dim3 {
 
 namespace {
 
-using OmMesh = OpenMesh::PolyMesh_ArrayKernelT<>;
+namespace om = OpenMesh;
+
+/// Records the vertices and faces a reader hands over, as they come (no halfedges, so nothing
+/// refused or split); everything else a reader may set (normals, colours, texture
+/// coordinates, status) is dropped. A face with fewer than three corners or a corner twice
+/// is kept aside as the first bad face, for the caller's message.
+class SoupImporter final : public om::IO::BaseImporter {
+ public:
+  std::vector<P3> points;
+  std::vector<std::vector<std::int32_t>> faces;
+  long long first_bad_face = -1;  ///< index among the faces handed over, -1: none
+  std::vector<std::int32_t> bad_corners;
+
+  om::VertexHandle add_vertex(const om::Vec3f& p) override { return add_vertex(om::Vec3d(p[0], p[1], p[2])); }
+  om::VertexHandle add_vertex(const om::Vec3d& p) override {
+    points.emplace_back(p[0], p[1], p[2]);
+    return om::VertexHandle(static_cast<int>(points.size()) - 1);
+  }
+  om::VertexHandle add_vertex() override { return add_vertex(om::Vec3d(0, 0, 0)); }
+  om::FaceHandle add_face(const VHandles& corners) override {
+    std::vector<std::int32_t> f;
+    f.reserve(corners.size());
+    for (const om::VertexHandle& v : corners) f.push_back(v.idx());
+    std::vector<std::int32_t> sorted = f;
+    std::sort(sorted.begin(), sorted.end());
+    const bool bad = f.size() < 3 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end() ||
+                     sorted.front() < 0 || sorted.back() >= static_cast<std::int32_t>(points.size());
+    const long long index = n_handed_++;
+    if (bad) {
+      if (first_bad_face < 0) first_bad_face = index, bad_corners = f;
+      return om::FaceHandle();
+    }
+    faces.push_back(std::move(f));
+    return om::FaceHandle(static_cast<int>(faces.size()) - 1);
+  }
+  long long n_handed() const { return n_handed_; }
+
+  om::HalfedgeHandle add_edge(om::VertexHandle, om::VertexHandle) override { return om::HalfedgeHandle(); }
+  om::FaceHandle add_face(om::HalfedgeHandle) override { return om::FaceHandle(); }
+  void add_face_texcoords(om::FaceHandle, om::VertexHandle, const std::vector<om::Vec2f>&) override {}
+  void add_face_texcoords(om::FaceHandle, om::VertexHandle, const std::vector<om::Vec3f>&) override {}
+  void set_face_texindex(om::FaceHandle, int) override {}
+  void set_point(om::VertexHandle v, const om::Vec3f& p) override {
+    if (v.idx() >= 0 && static_cast<std::size_t>(v.idx()) < points.size()) points[static_cast<std::size_t>(v.idx())] = P3(p[0], p[1], p[2]);
+  }
+  void set_halfedge(om::VertexHandle, om::HalfedgeHandle) override {}
+  void set_normal(om::VertexHandle, const om::Vec3f&) override {}
+  void set_normal(om::VertexHandle, const om::Vec3d&) override {}
+  void set_color(om::VertexHandle, const om::Vec3uc&) override {}
+  void set_color(om::VertexHandle, const om::Vec4uc&) override {}
+  void set_color(om::VertexHandle, const om::Vec3f&) override {}
+  void set_color(om::VertexHandle, const om::Vec4f&) override {}
+  void set_texcoord(om::VertexHandle, const om::Vec2f&) override {}
+  void set_status(om::VertexHandle, const om::Attributes::StatusInfo&) override {}
+  void set_next(om::HalfedgeHandle, om::HalfedgeHandle) override {}
+  void set_face(om::HalfedgeHandle, om::FaceHandle) override {}
+  void request_face_texcoords2D() override {}
+  void set_texcoord(om::HalfedgeHandle, const om::Vec2f&) override {}
+  void set_texcoord(om::VertexHandle, const om::Vec3f&) override {}
+  void set_texcoord(om::HalfedgeHandle, const om::Vec3f&) override {}
+  void set_status(om::HalfedgeHandle, const om::Attributes::StatusInfo&) override {}
+  void set_color(om::EdgeHandle, const om::Vec3uc&) override {}
+  void set_color(om::EdgeHandle, const om::Vec4uc&) override {}
+  void set_color(om::EdgeHandle, const om::Vec3f&) override {}
+  void set_color(om::EdgeHandle, const om::Vec4f&) override {}
+  void set_status(om::EdgeHandle, const om::Attributes::StatusInfo&) override {}
+  void set_normal(om::FaceHandle, const om::Vec3f&) override {}
+  void set_normal(om::FaceHandle, const om::Vec3d&) override {}
+  void set_color(om::FaceHandle, const om::Vec3uc&) override {}
+  void set_color(om::FaceHandle, const om::Vec4uc&) override {}
+  void set_color(om::FaceHandle, const om::Vec3f&) override {}
+  void set_color(om::FaceHandle, const om::Vec4f&) override {}
+  void set_status(om::FaceHandle, const om::Attributes::StatusInfo&) override {}
+  void add_texture_information(int, std::string) override {}
+  std::size_t n_vertices() const override { return points.size(); }
+  std::size_t n_faces() const override { return faces.size(); }
+  std::size_t n_edges() const override { return 0; }
+
+ private:
+  long long n_handed_ = 0;
+};
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -127,44 +212,45 @@ void check_binary_stl_size(const std::string& path) {
 TriangleSoup read_with_openmesh(const std::string& path) {
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
-  OmMesh mesh;
-  OpenMesh::IO::Options options;
-  // OpenMesh reports refused faces on omerr; the count check below turns them into an error.
+  SoupImporter soup_in;
+  om::IO::Options options;
+  // OpenMesh reports what it skips on omerr; the checks below turn that into an error.
   const bool err_was_enabled = omerr().is_enabled();
   omerr().disable();
-  const bool ok = OpenMesh::IO::read_mesh(mesh, path, options);
+  const bool ok = om::IO::IOManager().read(path, soup_in, options);
   if (err_was_enabled) omerr().enable();
-  if (ext == "stl" && (!ok || mesh.n_faces() == 0)) check_binary_stl_size(path);
+  if (ext == "stl" && (!ok || soup_in.faces.empty())) check_binary_stl_size(path);
   if (!ok) throw InputError(path + ": OpenMesh cannot read the file (unreadable or malformed " + ext + ")");
-  if (mesh.n_faces() == 0) throw InputError(path + ": empty surface (no faces)");
+  if (soup_in.first_bad_face >= 0) {
+    std::ostringstream corners;
+    for (std::size_t k = 0; k < soup_in.bad_corners.size(); ++k) corners << (k ? " " : "") << soup_in.bad_corners[k];
+    throw InputError(path + ": degenerate face " + std::to_string(soup_in.first_bad_face) + " (vertices " + corners.str() +
+                     "): fewer than three corners, a corner twice or an index out of range");
+  }
+  if (soup_in.faces.empty()) throw InputError(path + ": empty surface (no faces)");
 
   TriangleSoup soup;
-  soup.vertices.reserve(mesh.n_vertices());
-  for (const auto vh : mesh.vertices()) {
-    const auto& q = mesh.point(vh);
-    const P3 p(q[0], q[1], q[2]);
+  soup.vertices.reserve(soup_in.points.size());
+  for (std::size_t i = 0; i < soup_in.points.size(); ++i) {
+    const P3& p = soup_in.points[i];
     if (!p.allFinite())
-      throw InputError(path + ": non-finite coordinate in vertex " + std::to_string(vh.idx()) + " (" +
-                       std::to_string(q[0]) + ", " + std::to_string(q[1]) + ", " + std::to_string(q[2]) + ")");
+      throw InputError(path + ": non-finite coordinate in vertex " + std::to_string(i) + " (" + std::to_string(p.x()) +
+                       ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) + ")");
     soup.vertices.push_back(p);
   }
-  // OpenMesh either drops a face that would make an edge non-manifold, or duplicates its
-  // vertices to keep the mesh manifold: either way the counts no longer match the file.
+  // A reader may skip a face itself (an index out of range in OBJ or PLY, a facet whose corners
+  // merge in STL): then the counts no longer match the file.
   const Declared declared = declared_counts(path, ext);
-  if (declared.faces >= 0 && declared.faces != static_cast<long long>(mesh.n_faces()))
-    throw InputError(path + ": non-manifold or degenerate faces: the file declares " +
-                     std::to_string(declared.faces) + " faces but only " + std::to_string(mesh.n_faces()) +
-                     " could be added (the others would put more than two faces on an edge, or repeat a vertex)");
-  if (declared.vertices >= 0 && declared.vertices != static_cast<long long>(mesh.n_vertices()))
-    throw InputError(path + ": non-manifold: the file declares " + std::to_string(declared.vertices) +
-                     " vertices but OpenMesh needed " + std::to_string(mesh.n_vertices()) +
-                     " (it duplicates vertices where more than two faces meet at an edge or sheets touch)");
+  if (declared.faces >= 0 && declared.faces != soup_in.n_handed())
+    throw InputError(path + ": the file declares " + std::to_string(declared.faces) + " faces but OpenMesh read " +
+                     std::to_string(soup_in.n_handed()) +
+                     " (the others have an index out of range or corners that coincide)");
+  if (declared.vertices >= 0 && declared.vertices != static_cast<long long>(soup_in.points.size()))
+    throw InputError(path + ": the file declares " + std::to_string(declared.vertices) + " vertices but OpenMesh read " +
+                     std::to_string(soup_in.points.size()));
 
-  for (const auto fh : mesh.faces()) {
-    std::vector<std::int32_t> idx;
-    for (const auto vh : mesh.fv_range(fh)) idx.push_back(vh.idx());
-    for (std::size_t k = 1; k + 1 < idx.size(); ++k) soup.triangles.push_back({idx[0], idx[k], idx[k + 1]});
-  }
+  for (const std::vector<std::int32_t>& f : soup_in.faces)
+    for (std::size_t k = 1; k + 1 < f.size(); ++k) soup.triangles.push_back({f[0], f[k], f[k + 1]});
   return soup;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // Reading closed triangle surfaces: OFF is parsed here (so that every problem is seen and named
-// with its line: OpenMesh drops non-manifold faces silently), STL (ASCII and binary), OBJ and
-// PLY go through OpenMesh (openmesh_surface.cpp), whose face count is checked against what the
-// file declares. Polygons are split into triangle fans. Bad input throws InputError
+// with its line), STL (ASCII and binary), OBJ and PLY by OpenMesh's readers into a soup of our
+// own (openmesh_surface.cpp: every face as the file gives it, none dropped or split), whose face
+// count is checked against what the file declares. Polygons are split into triangle fans. Bad input throws InputError
 // "<path>[:<line>]: <reason>". Topology and geometry checks come after (surface_checks.hpp).
 
 #include <istream>

@@ -8,6 +8,8 @@
 # Usage: experiments/data_sweep3d.sh [BUILD_DIR] [OUT_DIR]
 #   LEVELS="4 5 6" KINDS="tet hex" SURFACES="sphere966 anchor" THREADS=1 narrow it down;
 #   ARGS="--buffer 0" passes more options to every run;
+#   SURFACE_DIR=dir sweeps the closed surfaces there instead (.off, .stl, .obj, .ply; e.g.
+#   examples/3d, the bundled machined parts);
 #   KEEP=0 removes each run's folder once its row is printed (level 6 meshes are 0.1-1 GB);
 #   the exit status is 1 when any run is not valid (the regression tests dim3_data_levels_SURFACE,
 #   tests/CMakeLists.txt, one per surface, run it at levels 4-6 in both kinds).
@@ -21,7 +23,10 @@ kinds=${KINDS:-"tet"}
 threads=${THREADS:-1}
 keep=${KEEP:-1}
 read -r -a args <<< "${ARGS:-}"
-surfaces=${SURFACES:-$(cd "$data/3d" && ls *.off | grep -v '^open-' | sed 's/\.off$//' | tr '\n' ' ')}
+dir=${SURFACE_DIR:-"$data/3d"}
+# A surface's file: NAME.off, .stl, .obj or .ply in $dir.
+file_of() { for e in off stl obj ply; do [ -f "$dir/$1.$e" ] && { echo "$dir/$1.$e"; return; }; done; echo "$dir/$1.off"; }
+surfaces=${SURFACES:-$(cd "$dir" && ls *.off *.stl *.obj *.ply 2>/dev/null | grep -v '^open-' | sed 's/\.[a-z]*$//' | sort -u | tr '\n' ' ')}
 [ -x /usr/bin/time ] || { echo "data_sweep3d: needs GNU time (/usr/bin/time)" >&2; exit 1; }
 mkdir -p "$out"
 failed=0
@@ -32,7 +37,7 @@ for s in $surfaces; do
     for kind in $kinds; do
       d="$out/$s-L$level-$kind"
       rm -rf "$d"
-      /usr/bin/time -f "%U %S %M" -o "$d.time" "$bin" mesh3d "$data/3d/$s.off" -o "$d" --level "$level" \
+      /usr/bin/time -f "%U %S %M" -o "$d.time" "$bin" mesh3d "$(file_of "$s")" -o "$d" --level "$level" \
         --elements "$kind" --threads "$threads" --allow-invalid "${args[@]}" >/dev/null 2>"$d.err"
       read -r user sys peak_kb < <(tail -n 1 "$d.time")
       python3 - "$d/report.json" "$s" "$level" "$kind" "$user" "$sys" "$peak_kb" "$d.err" <<'PY' > "$d.row"
