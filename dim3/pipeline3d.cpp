@@ -195,11 +195,14 @@ std::string volume_lost(double error) {
 }
 
 /// A level raise's options (Options3d::raise_levels): one level finer, one raise fewer, the tries
-/// at the finer level as they were (no thickness probe), refused early rather than after a huge
-/// tree (at most min_effort_octants octants).
+/// at the finer level as they are at that level (the thickness probe too), refused early rather
+/// than after a huge tree (at most min_effort_octants octants). Until session 50 the raise ran
+/// without the probe: examples/3d/tee.stl at level 4 (walls 0.6 of an octant) was raised to
+/// level 5 and refused there after 38 s, where level 5 asked directly stands at the probe's
+/// first tree (1,103,298 tets, 20.00 deg, 0.41% volume error); its level-4 run ended with an
+/// invalid mesh of 193 tets (99.6% of the volume lost). Now the raise stands in the same mesh.
 Options3d one_level_finer(const Options3d& opt) {
   Options3d finer = opt;
-  finer.thickness_probe = false;
   ++finer.level;
   --finer.raise_levels;
   finer.max_cells = std::min(opt.max_cells, opt.min_effort_octants);
