@@ -1,12 +1,13 @@
-// The OpenMesh adapter (STYLE.md §9): STL, OBJ and PLY are parsed by OpenMesh's readers into a
-// plain TriangleSoup through an importer of our own (SoupImporter), not into an OpenMesh mesh:
-// its halfedge kernel refuses a face whose winding runs an edge the way a neighbour already
-// runs it ("complex edge") and splits vertices to stay manifold, so a closed surface whose
-// triangles are not consistently wound (Gmsh's STL export of OpenCASCADE solids winds each
-// face by its own parametrisation) came out with boundary edges and was refused as "not
+// The OpenMesh adapter (STYLE.md §9): STL (ASCII and binary) is parsed by OpenMesh's reader
+// into a plain TriangleSoup through an importer of our own (SoupImporter), not into an OpenMesh
+// mesh: its halfedge kernel refuses a face whose winding runs an edge the way a neighbour
+// already runs it ("complex edge") and splits vertices to stay manifold, so a closed surface
+// whose triangles are not consistently wound (Gmsh's STL export of OpenCASCADE solids winds
+// each face by its own parametrisation) came out with boundary edges and was refused as "not
 // closed". The soup keeps every face as the file gives it; validate_surface names what is
 // wrong and orients what is only wound inconsistently. The face count is still compared with
-// what the file declares (faces a reader itself skips).
+// what the file declares (facets the reader itself skips). OBJ and PLY are parsed in
+// read_obj.cpp and read_ply.cpp (OpenMesh 9.0's readers abort or loop on bad input).
 #include <OpenMesh/Core/IO/IOManager.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/System/omstream.hh>
@@ -112,58 +113,26 @@ std::string lower(std::string s) {
   return s;
 }
 
-struct Declared {
-  long long faces = -1;     ///< -1: the file does not say
-  long long vertices = -1;
-};
-
-/// What the file declares, counted independently of OpenMesh.
-Declared declared_counts(const std::string& path, const std::string& ext) {
-  Declared out;
+/// How many facets an STL declares (binary: its header; ASCII: its "endfacet"s), counted
+/// independently of OpenMesh.
+long long declared_facets(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (ext == "stl") {
-    in.seekg(0, std::ios::end);
-    const auto size = static_cast<long long>(in.tellg());
-    in.seekg(0);
-    if (size >= 84) {
-      char header[84];
-      in.read(header, 84);
-      std::uint32_t n = 0;
-      std::memcpy(&n, header + 80, 4);  // little-endian on every platform we build for
-      if (size == 84 + 50LL * n) {
-        out.faces = n;
-        return out;
-      }
-    }
-    in.clear();
-    in.seekg(0);
-    long long count = 0;
-    for (std::string tok; in >> tok;)
-      if (lower(tok) == "endfacet") ++count;
-    out.faces = count;
-    return out;
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<long long>(in.tellg());
+  in.seekg(0);
+  if (size >= 84) {
+    char header[84];
+    in.read(header, 84);
+    std::uint32_t n = 0;
+    std::memcpy(&n, header + 80, 4);  // little-endian on every platform we build for
+    if (size == 84 + 50LL * n) return n;
   }
-  if (ext == "obj") {
-    out.faces = out.vertices = 0;
-    for (std::string line; std::getline(in, line);) {
-      if (line.size() < 2 || !std::isspace(static_cast<unsigned char>(line[1]))) continue;
-      if (line[0] == 'f') ++out.faces;
-      if (line[0] == 'v') ++out.vertices;
-    }
-    return out;
-  }
-  if (ext == "ply") {
-    for (std::string line; std::getline(in, line);) {
-      std::istringstream ss(line);
-      std::string a, b;
-      long long n = -1;
-      ss >> a >> b >> n;
-      if (a == "element" && b == "face") out.faces = n;
-      if (a == "element" && b == "vertex") out.vertices = n;
-      if (a == "end_header") break;
-    }
-  }
-  return out;
+  in.clear();
+  in.seekg(0);
+  long long count = 0;
+  for (std::string tok; in >> tok;)
+    if (lower(tok) == "endfacet") ++count;
+  return count;
 }
 
 /// Why OpenMesh made nothing of an STL, when it is a binary STL whose size is not what its
@@ -212,6 +181,7 @@ void check_binary_stl_size(const std::string& path) {
 TriangleSoup read_with_openmesh(const std::string& path) {
   const auto dot = path.find_last_of('.');
   const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
+  if (ext != "stl") throw InputError(path + ": not an .stl file (OBJ, PLY and OFF have readers of their own)");
   SoupImporter soup_in;
   om::IO::Options options;
   // OpenMesh reports what it skips on omerr; the checks below turn that into an error.
@@ -219,8 +189,8 @@ TriangleSoup read_with_openmesh(const std::string& path) {
   omerr().disable();
   const bool ok = om::IO::IOManager().read(path, soup_in, options);
   if (err_was_enabled) omerr().enable();
-  if (ext == "stl" && (!ok || soup_in.faces.empty())) check_binary_stl_size(path);
-  if (!ok) throw InputError(path + ": OpenMesh cannot read the file (unreadable or malformed " + ext + ")");
+  if (!ok || soup_in.faces.empty()) check_binary_stl_size(path);
+  if (!ok) throw InputError(path + ": OpenMesh cannot read the file (unreadable or malformed STL)");
   if (soup_in.first_bad_face >= 0) {
     std::ostringstream corners;
     for (std::size_t k = 0; k < soup_in.bad_corners.size(); ++k) corners << (k ? " " : "") << soup_in.bad_corners[k];
@@ -238,16 +208,11 @@ TriangleSoup read_with_openmesh(const std::string& path) {
                        ", " + std::to_string(p.y()) + ", " + std::to_string(p.z()) + ")");
     soup.vertices.push_back(p);
   }
-  // A reader may skip a face itself (an index out of range in OBJ or PLY, a facet whose corners
-  // merge in STL): then the counts no longer match the file.
-  const Declared declared = declared_counts(path, ext);
-  if (declared.faces >= 0 && declared.faces != soup_in.n_handed())
-    throw InputError(path + ": the file declares " + std::to_string(declared.faces) + " faces but OpenMesh read " +
-                     std::to_string(soup_in.n_handed()) +
-                     " (the others have an index out of range or corners that coincide)");
-  if (declared.vertices >= 0 && declared.vertices != static_cast<long long>(soup_in.points.size()))
-    throw InputError(path + ": the file declares " + std::to_string(declared.vertices) + " vertices but OpenMesh read " +
-                     std::to_string(soup_in.points.size()));
+  // The reader may skip a facet itself: then the counts no longer match the file.
+  const long long declared = declared_facets(path);
+  if (declared != soup_in.n_handed())
+    throw InputError(path + ": the file declares " + std::to_string(declared) + " facets but OpenMesh read " +
+                     std::to_string(soup_in.n_handed()));
 
   for (const std::vector<std::int32_t>& f : soup_in.faces)
     for (std::size_t k = 1; k + 1 < f.size(); ++k) soup.triangles.push_back({f[0], f[k], f[k + 1]});

@@ -10,8 +10,11 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "dim3/surface_text.hpp"
 
 namespace febemesh::dim3 {
+
+using namespace text;
 
 namespace {
 
@@ -21,53 +24,6 @@ std::string lower_extension(const std::string& path) {
   std::string ext = path.substr(dot + 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
-}
-
-/// Non-empty lines with comments (#...) removed, each with its 1-based line number.
-struct Lines {
-  std::vector<std::pair<std::string, int>> items;
-  std::size_t next = 0;
-  bool done() const { return next >= items.size(); }
-};
-
-Lines content_lines(std::istream& in) {
-  Lines lines;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const auto hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    // Blank = only what split() skips (isspace: \f and \v too), so every kept line has a token.
-    if (line.find_first_not_of(" \t\r\n\f\v") == std::string::npos) continue;
-    lines.items.emplace_back(line, number);
-  }
-  return lines;
-}
-
-std::vector<std::string> split(const std::string& s) {
-  std::istringstream ss(s);
-  std::vector<std::string> out;
-  for (std::string tok; ss >> tok;) out.push_back(tok);
-  return out;
-}
-
-bool parse_double(const std::string& s, double& out) {
-  errno = 0;
-  char* end = nullptr;
-  out = std::strtod(s.c_str(), &end);
-  return end != s.c_str() && *end == '\0';
-}
-
-bool parse_long(const std::string& s, long long& out) {
-  errno = 0;
-  char* end = nullptr;
-  out = std::strtoll(s.c_str(), &end, 10);
-  return end != s.c_str() && *end == '\0' && errno == 0;
-}
-
-[[noreturn]] void fail(const std::string& name, int line, const std::string& why) {
-  throw InputError(name + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + why);
 }
 
 }  // namespace
@@ -149,6 +105,8 @@ TriangleSoup read_surface(const std::string& path) {
   if (!in) throw InputError(path + ": cannot open the file");
   if (in.peek() == std::ifstream::traits_type::eof()) throw InputError(path + ": empty file");
   if (ext == "off") return read_off(in, path);
+  if (ext == "obj") return read_obj(in, path);
+  if (ext == "ply") return read_ply(in, path);
   in.close();
   return read_with_openmesh(path);
 }

@@ -22,7 +22,9 @@ TEST_CASE("inputs found by the fuzzers are read or refused with InputError", "[f
       {"native", febemesh::fuzz::native_input},
       {"poly", febemesh::fuzz::poly_input},
       {"off", febemesh::fuzz::off_input},
-      {"stl", febemesh::fuzz::stl_input}};
+      {"stl", febemesh::fuzz::stl_input},
+      {"obj", febemesh::fuzz::obj_input},
+      {"ply", febemesh::fuzz::ply_input}};
   for (const auto& [dir, run] : targets) {
     if (!fs::exists(root / dir)) continue;
     std::vector<fs::path> files;

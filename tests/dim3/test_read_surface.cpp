@@ -3,6 +3,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -326,24 +327,86 @@ TEST_CASE("STL, OBJ and PLY whose triangles are wound inconsistently are read wh
   }
 }
 
-TEST_CASE("an OBJ face with a corner twice is refused naming the face", "[read_surface]") {
-  const fs::path obj = scratch("repeated-corner.obj");
-  {
-    std::ofstream o(obj);
-    for (const auto& v : cube_v) o << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
+TEST_CASE("OBJ and PLY are read in double precision and their faults named with the line", "[read_surface]") {
+  const auto refusal = [](const fs::path& path, const std::string& text) {
+    std::ofstream(path, std::ios::binary) << text;
+    try {
+      Surface s(read_surface(path.string()));
+      validate_surface(s, path.string());
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string obj_cube, ply_cube;
+  for (const auto& v : cube_v) obj_cube += "v " + std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + "\n";
+  const auto obj_faces = [](int bad, const std::string& corner) {
+    std::string out;
     for (int f = 0; f < 12; ++f)
-      o << "f " << cube_f[f][0] + 1 << " " << (f == 5 ? cube_f[f][0] : cube_f[f][1]) + 1 << " " << cube_f[f][2] + 1 << "\n";
+      out += "f " + (f == bad ? corner : std::to_string(cube_f[f][0] + 1)) + " " + std::to_string(cube_f[f][1] + 1) + " " +
+             std::to_string(cube_f[f][2] + 1) + "\n";
+    return out;
+  };
+  const fs::path obj = scratch("faulty.obj"), ply = scratch("faulty.ply");
+  // Lines 1-8 are the vertices, 9-20 the faces.
+  CHECK_THAT(refusal(obj, obj_cube + obj_faces(5, "6")), Catch::StartsWith(obj.string() + ":14: face 5: vertex 6 appears twice"));
+  CHECK_THAT(refusal(obj, obj_cube + obj_faces(2, "0")), Catch::Contains(":11: face 2: vertex index 0 (OBJ counts vertices from 1)"));
+  CHECK_THAT(refusal(obj, obj_cube + obj_faces(3, "9")), Catch::Contains(":12: face 3: vertex index 9 out of range (the file has 8 vertices)"));
+  CHECK_THAT(refusal(obj, obj_cube + obj_faces(0, "-9")), Catch::Contains(":9: face 0: vertex index -9 reaches before the first vertex"));
+  CHECK_THAT(refusal(obj, obj_cube + "f 1 2\n"), Catch::Contains(":9: face 0: fewer than three corners"));
+  CHECK_THAT(refusal(obj, "v 0 0 nan\n" + obj_faces(-1, "")), Catch::Contains(":1: non-finite coordinate in vertex 0"));
+  CHECK_THAT(refusal(obj, "# nothing\n"), Catch::Contains("empty surface: 0 vertices, 0 faces"));
+  // Negative indices count back from the last vertex; other statements are skipped.
+  std::string relative = "o cube\nvt 0 0\n" + obj_cube + "vn 0 0 1\ns off\n";
+  for (int f = 0; f < 12; ++f)
+    relative += "f " + std::to_string(cube_f[f][0] - 8) + "/1/1 " + std::to_string(cube_f[f][1] - 8) + "//1 " +
+                std::to_string(cube_f[f][2] + 1) + "/1\n";
+  CHECK(refusal(obj, relative).empty());
+  // Double precision (OpenMesh read 0.1000000000001 as 0.10000000149011612).
+  {
+    std::ofstream(obj) << "v 0.1000000000001 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const TriangleSoup soup = read_surface(obj.string());
+    CHECK(soup.vertices[0].x() == 0.1000000000001);
   }
-  std::string msg;
-  try {
-    (void)read_surface(obj.string());
-  } catch (const InputError& e) {
-    msg = e.what();
+  const std::string header = "ply\nformat ascii 1.0\ncomment a cube\nelement vertex 8\nproperty double x\nproperty double y\n"
+                             "property double z\nproperty uchar red\nelement face 12\nproperty list uchar int vertex_indices\n"
+                             "end_header\n";
+  for (const auto& v : cube_v) ply_cube += std::to_string(v[0]) + " " + std::to_string(v[1]) + " " + std::to_string(v[2]) + " 255\n";
+  std::string ply_faces;
+  for (int f = 0; f < 12; ++f) ply_faces += "3 " + std::to_string(cube_f[f][0]) + " " + std::to_string(cube_f[f][1]) + " " + std::to_string(cube_f[f][2]) + "\n";
+  CHECK(refusal(ply, header + ply_cube + ply_faces).empty());
+  CHECK_THAT(refusal(ply, "ply\nformat ascii 1.0\nelement vertex 8\n"), Catch::Contains("truncated header: no end_header"));
+  CHECK_THAT(refusal(ply, "ply\nformat ascii 1.0\nelement vertex 8\nend_hea\n"), Catch::Contains(":4: unknown header keyword 'end_hea'"));
+  CHECK_THAT(refusal(ply, "solid x\n"), Catch::Contains(":1: not a PLY file"));
+  CHECK_THAT(refusal(ply, header + ply_cube + "3 0 1 8" + ply_faces.substr(ply_faces.find('\n'))),
+             Catch::Contains("face 0: vertex index 8 out of range"));
+  CHECK_THAT(refusal(ply, header + ply_cube + ply_faces.substr(0, ply_faces.size() - 2)),
+             Catch::Contains(":31: truncated: the file ends before face 11 (vertex_indices)"));
+  std::string big = header;
+  big.replace(big.find("element face 12"), 15, "element face 999999999");
+  CHECK_THAT(refusal(ply, big + ply_cube + ply_faces), Catch::Contains(":9: element face declares 999999999 items, more than the file holds"));
+  // Binary, big-endian, float coordinates and a short list count.
+  {
+    std::ofstream b(ply, std::ios::binary);
+    b << "ply\nformat binary_big_endian 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+         "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
+    const auto put = [&](auto value) {
+      char bytes[sizeof value];
+      std::memcpy(bytes, &value, sizeof value);
+      std::reverse(bytes, bytes + sizeof value);
+      b.write(bytes, sizeof value);
+    };
+    for (const auto& v : cube_v)
+      for (int d = 0; d < 3; ++d) put(static_cast<float>(v[d]));
+    for (int f = 0; f < 12; ++f) {
+      b.put(3);
+      for (int k = 0; k < 3; ++k) put(static_cast<std::int32_t>(cube_f[f][k]));
+    }
   }
-  INFO(msg);
-  CHECK(msg.find(obj.string() + ": ") == 0);
-  // OpenMesh's OBJ reader hands the face over (then it is named) or skips it (then the count).
-  CHECK((msg.find("degenerate face 5") != std::string::npos || msg.find("declares 12 faces but OpenMesh read 11") != std::string::npos));
+  Surface s(read_surface(ply.string()));
+  validate_surface(s, ply.string());
+  CHECK(s.n_triangles() == 12);
+  CHECK(s.volume() == Approx(1.0));
 }
 
 TEST_CASE("a Gmsh STL export wound face by face (examples/3d/block.stl) is read whole and oriented", "[read_surface]") {

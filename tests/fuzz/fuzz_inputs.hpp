@@ -73,4 +73,21 @@ inline void stl_input(std::string_view data) {
   std::filesystem::remove(path);
 }
 
+/// The bytes as OBJ or PLY (read_obj, read_ply), then indexed as a Surface.
+inline void obj_input(std::string_view data) {
+  std::istringstream in{std::string(data)};
+  try {
+    (void)dim3::Surface(dim3::read_obj(in, "fuzz.obj"));
+  } catch (const InputError&) {
+  }
+}
+
+inline void ply_input(std::string_view data) {
+  std::istringstream in{std::string(data), std::ios::in | std::ios::binary};
+  try {
+    (void)dim3::Surface(dim3::read_ply(in, "fuzz.ply"));
+  } catch (const InputError&) {
+  }
+}
+
 }  // namespace febemesh::fuzz
