@@ -368,9 +368,9 @@ TEST_CASE("mesh3d data: elephant level 4 (valid after refining around its island
 TEST_CASE("mesh3d examples: the bundled machined parts that mesh today (examples/3d)", "[data][pipeline3d]") {
   // Gmsh STL exports (examples/3d/README.md), with the CLI's defaults. Measured (session 50,
   // CLI --threads 1): bracket L4 31,172 tets, 19.56 deg, 4.84% volume error, 0.5 s; gear L5
-  // 157,257 tets, 20.73 deg, 1.02%, 1.9 s. (Not here: block, refused at level 4 and invalid at
-  // level 5, and the tee at level 4, whose walls are 0.6 octant thick; README's known
-  // limitations.)
+  // 157,257 tets, 20.73 deg, 1.02%, 1.9 s. (Not here: the block, refused at levels 4 and 6 and
+  // invalid at level 5, and the flange and the tee at level 6, refused; README's known
+  // limitations. The tee at level 4: the [slow] case below.)
   const std::string dir = std::string(FEBEMESH_SOURCE_DIR) + "/examples/3d/";
   struct Case {
     const char* part;
