@@ -2,11 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <vector>
 
 #include "core/error.hpp"

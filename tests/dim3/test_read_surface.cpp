@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -71,7 +72,45 @@ const double cube_v[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 
 const int cube_f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
 
-P3 cube_point(int f, int k) { return P3(cube_v[cube_f[f][k]][0], cube_v[cube_f[f][k]][1], cube_v[cube_f[f][k]][2]); }
+/// The cube as OBJ, ASCII PLY (coordinates of `ply_type`), ASCII STL and binary STL: scratch
+/// files STEM.obj, STEM.ply, STEM-ascii.stl and STEM-binary.stl, corner k of face f being
+/// vertex corner(f, k).
+template <class Corner>
+std::array<fs::path, 4> write_cube(const std::string& stem, const std::string& ply_type, const Corner& corner) {
+  const fs::path obj = scratch(stem + ".obj"), ply = scratch(stem + ".ply"), ascii = scratch(stem + "-ascii.stl"),
+                 binary = scratch(stem + "-binary.stl");
+  std::ofstream o(obj), p(ply), a(ascii), b(binary, std::ios::binary);
+  p << "ply\nformat ascii 1.0\nelement vertex 8\nproperty " << ply_type << " x\nproperty " << ply_type << " y\nproperty "
+    << ply_type << " z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n";
+  for (const auto& v : cube_v) {
+    o << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
+    p << v[0] << " " << v[1] << " " << v[2] << "\n";
+  }
+  a << "solid " << stem << "\n";
+  char header[80] = {};
+  const std::string title = "binary " + stem;
+  std::memcpy(header, title.data(), std::min<std::size_t>(title.size(), sizeof header));
+  b.write(header, 80);
+  const std::uint32_t n = 12;
+  b.write(reinterpret_cast<const char*>(&n), 4);
+  for (int f = 0; f < 12; ++f) {
+    o << "f " << corner(f, 0) + 1 << " " << corner(f, 1) + 1 << " " << corner(f, 2) + 1 << "\n";
+    p << "3 " << corner(f, 0) << " " << corner(f, 1) << " " << corner(f, 2) << "\n";
+    a << " facet normal 0 0 0\n  outer loop\n";
+    float values[12] = {};
+    for (int k = 0; k < 3; ++k) {
+      const double* q = cube_v[corner(f, k)];
+      a << "   vertex " << q[0] << " " << q[1] << " " << q[2] << "\n";
+      for (int d = 0; d < 3; ++d) values[3 + 3 * k + d] = static_cast<float>(q[d]);
+    }
+    a << "  endloop\n endfacet\n";
+    b.write(reinterpret_cast<const char*>(values), sizeof values);
+    const std::uint16_t attr = 0;
+    b.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+  a << "endsolid " << stem << "\n";
+  return {obj, ply, ascii, binary};
+}
 
 }  // namespace
 
@@ -194,45 +233,7 @@ TEST_CASE("bad inputs are refused with the file name and the reason", "[read_sur
 }
 
 TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_surface]") {
-  const fs::path obj = scratch("cube.obj"), ply = scratch("cube.ply"), ascii = scratch("cube-ascii.stl"),
-                 binary = scratch("cube-binary.stl");
-  {
-    std::ofstream o(obj), p(ply), a(ascii);
-    p << "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
-         "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
-    for (const auto& v : cube_v) {
-      o << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
-      p << v[0] << " " << v[1] << " " << v[2] << "\n";
-    }
-    a << "solid cube\n";
-    for (int f = 0; f < 12; ++f) {
-      o << "f " << cube_f[f][0] + 1 << " " << cube_f[f][1] + 1 << " " << cube_f[f][2] + 1 << "\n";
-      p << "3 " << cube_f[f][0] << " " << cube_f[f][1] << " " << cube_f[f][2] << "\n";
-      a << " facet normal 0 0 0\n  outer loop\n";
-      for (int k = 0; k < 3; ++k) {
-        const P3 q = cube_point(f, k);
-        a << "   vertex " << q.x() << " " << q.y() << " " << q.z() << "\n";
-      }
-      a << "  endloop\n endfacet\n";
-    }
-    a << "endsolid cube\n";
-  }
-  {
-    std::ofstream b(binary, std::ios::binary);
-    char header[80] = {};
-    std::memcpy(header, "binary cube", 11);
-    b.write(header, 80);
-    const std::uint32_t n = 12;
-    b.write(reinterpret_cast<const char*>(&n), 4);
-    for (int f = 0; f < 12; ++f) {
-      float values[12] = {};
-      for (int k = 0; k < 3; ++k)
-        for (int d = 0; d < 3; ++d) values[3 + 3 * k + d] = static_cast<float>(cube_point(f, k)[d]);
-      b.write(reinterpret_cast<const char*>(values), sizeof values);
-      const std::uint16_t attr = 0;
-      b.write(reinterpret_cast<const char*>(&attr), 2);
-    }
-  }
+  const auto [obj, ply, ascii, binary] = write_cube("cube", "float", [](int f, int k) { return cube_f[f][k]; });
   // A binary STL whose header begins with "solid", as some exporters write it.
   const fs::path solid_binary = scratch("cube-binary-solid.stl");
   {
@@ -281,38 +282,7 @@ TEST_CASE("STL, OBJ and PLY whose triangles are wound inconsistently are read wh
     const bool flip = f % 3 == 1;
     return flip && k > 0 ? cube_f[f][3 - k] : cube_f[f][k];
   };
-  const fs::path obj = scratch("wound.obj"), ply = scratch("wound.ply"), ascii = scratch("wound-ascii.stl"),
-                 binary = scratch("wound-binary.stl");
-  {
-    std::ofstream o(obj), p(ply), a(ascii), b(binary, std::ios::binary);
-    p << "ply\nformat ascii 1.0\nelement vertex 8\nproperty double x\nproperty double y\nproperty double z\n"
-         "element face 12\nproperty list uchar int vertex_indices\nend_header\n";
-    for (const auto& v : cube_v) {
-      o << "v " << v[0] << " " << v[1] << " " << v[2] << "\n";
-      p << v[0] << " " << v[1] << " " << v[2] << "\n";
-    }
-    a << "solid wound\n";
-    char header[80] = {};
-    b.write(header, 80);
-    const std::uint32_t n = 12;
-    b.write(reinterpret_cast<const char*>(&n), 4);
-    for (int f = 0; f < 12; ++f) {
-      o << "f " << corner(f, 0) + 1 << " " << corner(f, 1) + 1 << " " << corner(f, 2) + 1 << "\n";
-      p << "3 " << corner(f, 0) << " " << corner(f, 1) << " " << corner(f, 2) << "\n";
-      a << " facet normal 0 0 0\n  outer loop\n";
-      float values[12] = {};
-      for (int k = 0; k < 3; ++k) {
-        const double* q = cube_v[corner(f, k)];
-        a << "   vertex " << q[0] << " " << q[1] << " " << q[2] << "\n";
-        for (int d = 0; d < 3; ++d) values[3 + 3 * k + d] = static_cast<float>(q[d]);
-      }
-      a << "  endloop\n endfacet\n";
-      b.write(reinterpret_cast<const char*>(values), sizeof values);
-      const std::uint16_t attr = 0;
-      b.write(reinterpret_cast<const char*>(&attr), 2);
-    }
-    a << "endsolid wound\n";
-  }
+  const auto [obj, ply, ascii, binary] = write_cube("wound", "double", corner);
   for (const fs::path& path : {obj, ply, ascii, binary}) {
     INFO(path);
     Surface s(read_surface(path.string()));

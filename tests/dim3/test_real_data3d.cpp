@@ -90,14 +90,13 @@ struct DataRun {
 /// The surface at `path` through mesh3d with `opt`, then the validator and the fidelity checks.
 DataRun mesh_and_validate_file(const std::string& path, const Options3d& opt) {
   SurfaceBoundary s = SurfaceBoundary::from_file(path);
-  const std::string& name = path;
   const int level = opt.level;
   const Result3d r = mesh3d(s, opt);
   const Mesh<3>& m = r.fe.mesh;
   REQUIRE(m.solid.size() > 0);
   const ValidateOptions<3> vo = surface_validation(s);
   const ValidationReport v = validate(m, vo);
-  INFO(name << " level " << level << ": " << v.summary());
+  INFO(path << " level " << level << ": " << v.summary());
   CHECK(v.valid);
   const QualitySummary q = summarize_quality(m);
   CHECK(q.min_angle_deg > 0.0);
