@@ -96,7 +96,9 @@ const char* help_text =
     "                      surface's units (the level whose octants are no larger, in a\n"
     "                      root cube enlarged by less than 2x so that they are H; the\n"
     "                      element count then follows H instead of 8x steps)\n"
-    "  --extra-levels N    extra levels for curvature and features (0..4, default 2)\n"
+    "  --extra-levels N    extra levels for curvature and features (0..4, default 2);\n"
+    "                      when every try with them is refused, the run goes on with\n"
+    "                      the surface at the one level (report.json surface_uniform)\n"
     "  --elements KIND     tet (default), or hex: hex-dominant (hexahedra where the octants\n"
     "                      conform, pyramids and tetrahedra elsewhere; quad BE faces where\n"
     "                      a hexahedron's or pyramid's surface face stays a quad)\n"
@@ -324,6 +326,7 @@ int run(const std::vector<std::string>& argv) {
                     {"thickness_refined", r.thickness_refined},
                     {"thickness_after_refusal", r.thickness_after_refusal},
                     {"thin_parts_coarse", r.thin_parts_coarse},
+                    {"surface_uniform", r.surface_uniform},
                     {"thickness_early", r.thickness_early},
                     {"level_raised", r.level_raised},
                     {"align_planar_faces", opt.align_planar_faces},

@@ -783,6 +783,16 @@ OctantComplexResult build_octant_complex(const Orthtree<3>& t, const Flags& in, 
       ClosestPoint<3>& cp = found[q];
       cp = s.closest_point(oc.points[q]);
       how[q] = How::closest;
+      if (std::abs(worst_outward(oc.points[q], cp.point, node_dirs[q])) < opt.in_plane_cosine) {
+        const std::vector<P3> dirs = ray_directions(node_dirs[q]);
+        ClosestPoint<3> c;
+        if (dirs.size() > 2 && ray_surface_point(s, oc.points[q], dirs[0], 4.0 * node_h[q], c) &&
+            proj.admissible(oc.points[q], c.point, node_dirs[q], c.where.patch)) {
+          cp = c;
+          how[q] = How::ray;
+          continue;
+        }
+      }
       if (proj.admissible(oc.points[q], cp.point, node_dirs[q], cp.where.patch)) continue;
       // The next local minima of the distance, then rays along the free faces' normals.
       const std::vector<ClosestPoint<3>> cands = s.closest_points(oc.points[q], opt.max_normals);

@@ -154,6 +154,19 @@ struct BoundaryOctantOptions {
   /// min_outward must hold for every free face of the node, not just one.
   bool outward_all_faces = false;
   bool rays = true;                  ///< try rays along the free faces' normals
+  /// At a node with free faces along two or more axes (an edge or corner of the interior
+  /// region), a closest point whose direction runs in the plane of one of those faces and back
+  /// against none (its smallest cosine with their normals within +-this of 0; 0 = off) is
+  /// replaced by the surface point along the sum of the faces' normals, where that one is
+  /// admissible. Where the level changes along a flat face the interior octants' staircase has
+  /// a step whose face stands square to the surface: the closest points of its nodes run in its
+  /// plane and its boundary octant is flat. Measured (session 51, diagnose3d --snap --buffer 0,
+  /// folded boundary octants of the first tree at level 6): an axis-parallel box 458 -> 0,
+  /// flange 2923 -> 1842, bracket 1353 -> 234, fandisk 1957 -> 1196, anchor 812 -> 156,
+  /// elephant 1355 -> 1356, sphere966 0 -> 0. Directions backward against a face are left
+  /// alone: a first version that replaced every cosine under 0.01 (backward ones too) left
+  /// elephant L4 invalid in the CLI.
+  double in_plane_cosine = 0.0;
   /// Unfold backward projections (unfold_backward in boundary_octants.cpp): a surface node
   /// whose projection runs back against a free face of its face node (cos < 0) and folds cones
   /// of its boundary octants takes the other candidate (next local minima, rays) that folds

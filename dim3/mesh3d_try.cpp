@@ -356,6 +356,7 @@ struct RepairLoop {
     bo.outward_all_faces = opt.outward_all_faces;
     bo.rays = opt.projection_rays;
     bo.unfold_backward = opt.unfold_backward;
+    bo.in_plane_cosine = opt.in_plane_cosine;
     bo.n_threads = opt.n_threads;
     tm.oc = build_octant_complex(tree, tm.in, s, bo);
     clock.lap("boundary octants");

@@ -28,6 +28,9 @@ struct Effort {
   /// Options3d::min_effort_octants octants: where a level raise (Options3d::raise_levels)
   /// applies, whether or not the run made it.
   bool refused_cheaply = false;
+  /// The tries with the curvature and feature levels were refused and the run went on with the
+  /// surface at the one level (Options3d::uniform_after_refusal): its lattice draws start there.
+  bool uniform_tried = false;
 };
 
 /// One try of the pipeline with `opt` (no fallback): `s` gets the options' levels, `effort`

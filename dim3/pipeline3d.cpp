@@ -321,7 +321,43 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   throw E(reasons + "; without the feature level: " + why);
 }
 
+Options3d uniform_try_options(const Options3d& opt) {
+  Options3d uniform = opt;
+  uniform.extra_levels = 0;
+  uniform.raise_levels = 0;
+  uniform.in_plane_cosine = opt.uniform_in_plane_cosine;
+  return uniform;
+}
+
 namespace {
+
+/// The refusal `e` of every other try (after `effort`): once more with the surface at the one
+/// level (Options3d::uniform_after_refusal), within its own work bound of opt.effort first
+/// trees; refused too, `e` with both reasons.
+Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
+                               const Progress3& progress) {
+  if (!opt.uniform_after_refusal || opt.extra_levels <= 0) throw e;
+  const Options3d uniform = uniform_try_options(opt);
+  if (progress)
+    progress(std::string("refused (") + e.what() + "): once more with the surface at level " +
+             std::to_string(opt.level) + " only (no curvature or feature levels)");
+  effort.uniform_tried = true;
+  Effort own;
+  std::string why;
+  try {
+    Result3d r = mesh3d_tries(s, uniform, own, progress);
+    effort.used += own.used;
+    r.n_octants_built = effort.used;
+    r.surface_uniform = true;
+    return r;
+  } catch (const GeometryError& f) {
+    why = f.what();
+  } catch (const LimitError& f) {
+    why = f.what();
+  }
+  effort.used += own.used;
+  throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) + " only: " + why);
+}
 
 /// mesh3d in the surface's own axes: the tries, the fallbacks after a refusal (unless
 /// `draw`: a lattice draw's refusal is its end), the thin retry. `effort` may come with a limit.
@@ -331,8 +367,12 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
   try {
     r = mesh3d_raised(s, opt, effort, progress);
   } catch (const GeometryError& e) {
-    if (draw) throw;
-    return after_refusal(s, opt, effort, e, progress);
+    if (draw) return uniform_after_refusal(s, opt, effort, e, progress);
+    try {
+      return after_refusal(s, opt, effort, e, progress);
+    } catch (const GeometryError& f) {
+      return uniform_after_refusal(s, opt, effort, f, progress);
+    }
   } catch (const LimitError& e) {
     if (draw) throw;
     return after_refusal(s, opt, effort, e, progress);
@@ -619,7 +659,22 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     }
     Options3d o = options_of(p.in_frame);
     if (raise_after_draws && i == 0) o.raise_levels = 0;
+    // A draw after a run whose tries with the curvature and feature levels were refused starts
+    // with the surface at the one level (Options3d::uniform_after_refusal), as that run went on:
+    // the refused tries cost the most (examples/3d/flange.stl level 6: 89 s of its first draw's
+    // 95 s; started there, the draw made the same mesh in 7.5 s; docs/measurements.md, session
+    // 51).
+    const bool uniform_draw = p.draw > 0 && runs.back().effort.uniform_tried && o.extra_levels > 0;
+    if (uniform_draw) {
+      o = uniform_try_options(o);
+      if (progress) progress("lattice draw " + std::to_string(p.draw) + ": with the surface at level " +
+                             std::to_string(o.level) + " only, as the run before it went on");
+    }
     runs.push_back(run_drawn(surface_of(p.in_frame), o, p.draw, limit, origin, progress));
+    if (uniform_draw) {
+      runs.back().effort.uniform_tried = true;
+      if (runs.back().r) runs.back().r->surface_uniform = true;
+    }
     settle(runs.back(), p.in_frame);
     rank_last();
     if (runs.back().rank == 0) break;

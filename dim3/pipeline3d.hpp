@@ -123,6 +123,11 @@ struct Options3d {
   bool outward_all_faces = false;
   bool projection_rays = true;
   bool unfold_backward = false;      ///< BoundaryOctantOptions::unfold_backward (off: see there)
+  /// BoundaryOctantOptions::in_plane_cosine (0 = off). Off but in the try with the surface at
+  /// one level (uniform_in_plane_cosine): on in every try, it changed the shared surfaces'
+  /// meshes (session 51, tet L4-6: all valid and at 15 deg or more but spool L6, refused after
+  /// 494 s instead of valid; anchor L6 19.29 -> 16.03 deg; gear L6 4.7 M tets in 279 s).
+  double in_plane_cosine = 0.0;
   int untangle_rounds = 4;            ///< rounds of moving surface nodes of inverted tets
   int untangle_sweeps = 30;          ///< node-by-node untangling sweeps (tet_optimize)
   int escobar_sweeps = 100;          ///< last-resort untangling sweeps by the Escobar objective (0 = none)
@@ -225,6 +230,22 @@ struct Options3d {
   /// alone, diagnose3d --feature-extra 0 --thin-cells 0 --island-refinements 0 --pipeline):
   /// valid, 162,253 tets, 20.01 deg, 30.36% of the volume (the blades) lost.
   bool coarse_thin_after_refusal = true;
+  /// When every try at the level is refused (those of the thickness level and with the thin
+  /// parts coarse too, where they apply), once more with the surface at that one level:
+  /// extra_levels 0 (no curvature or feature level), within its own work bound
+  /// (uniform_try_options, Result3d::surface_uniform); the lattice draws after such a run start
+  /// there. Where the level changes along the surface the interior octants' staircase has steps
+  /// whose faces stand across the surface, and their boundary octants fold; the repairs refine
+  /// around the folds and add more steps. Measured (session 51, CLI, one thread):
+  /// examples/3d/flange.stl level 6, refused after 260 s through every try and lattice draw,
+  /// was valid at --extra-levels 0 in 13 s (457,574 tets, 22.99 deg), and is valid with this
+  /// try in 69.5 s (457,543 tets, 27.11 deg); the block is valid at levels 4-6 (refused or
+  /// invalid before), the tee at level 6 (15.17 deg, 232 s).
+  bool uniform_after_refusal = true;
+  /// in_plane_cosine in that try: there the level no longer changes along the surface, and
+  /// its steps are those of the thickness level and the repairs (examples/3d/block.stl level 6
+  /// stood there with it, session 51).
+  double uniform_in_plane_cosine = 0.01;
   int max_level = -1;                ///< no octant finer than this; -1 = level + extra_levels + 2
   std::size_t max_cells = 20000000;  ///< refuse larger trees (LimitError)
   /// The work bound, so that no input runs for ever: the octants of every tree the boundary
@@ -325,6 +346,7 @@ struct Result3d {
   bool thickness_refined = false;    ///< lost volume; this run has Options3d::thin_retry_cells' thickness level
   bool thickness_after_refusal = false;  ///< refused; this run has Options3d::refused_thickness_cells' thickness level
   bool thin_parts_coarse = false;    ///< refused; this run has Options3d::coarse_thin_after_refusal's rules
+  bool surface_uniform = false;      ///< refused; this run has Options3d::uniform_after_refusal's one level
   bool thickness_early = false;      ///< the first tree had problems; this run is Options3d::thickness_probe's tree
   int level = 0;                     ///< the level asked for: Options3d::level, or the one Options3d::size gave
   double root_scale = 1.0;           ///< SurfaceOptions::root_scale of the run (Options3d::size)
@@ -401,6 +423,10 @@ Options3d facing_try_options(const Options3d& opt);
 /// (its one-octant slabs in thin parts project through them), no level raise, its own work
 /// bound of thin_retry_effort first trees.
 Options3d thickness_try_options(const Options3d& opt);
+
+/// The options of the try with the surface at one level (Options3d::uniform_after_refusal):
+/// extra_levels 0, no level raise, in_plane_cosine uniform_in_plane_cosine.
+Options3d uniform_try_options(const Options3d& opt);
 
 /// Is part of the solid thinner than Options3d::refused_thickness_cells octants of level + 1
 /// (where the thickness level passes the feature level, so that the thickness try's first tree

@@ -52,7 +52,7 @@ if not os.path.exists(path):
     sys.exit(0)
 r = json.load(open(path))
 c, q, f, v = r["counts"], r["quality"], r["fidelity"], r["validation"]
-notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal", "thickness_early", "thin_parts_coarse", "frame_turned", "frame_refused")
+notes = [k for k in ("buffer_rule_dropped", "buffer_rule_fallback", "feature_snapping_dropped", "facing_projection", "thickness_refined", "thickness_after_refusal", "thickness_early", "thin_parts_coarse", "surface_uniform", "frame_turned", "frame_refused")
          if r["options"].get(k)]
 if r["options"].get("level_raised"):
     notes.append(f"level_raised {r['options']['level_raised']}")

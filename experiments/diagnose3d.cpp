@@ -211,6 +211,8 @@ constexpr const char* usage =
     "  --repair-at-cells     Options3d::repair_at_cells (refine at the cells behind the untangling's faults)\n"
     "  --untangle-reach R    Options3d::untangle_reach (the untangling's moves off the surface bounded)\n"
     "  --backward-along C    with --graze-region: BoundaryOctantOptions::backward_along\n"
+    "  --in-plane C          BoundaryOctantOptions::in_plane_cosine (0 = off, the default;\n"
+    "                        the try with the surface at one level has 0.01)\n"
     "whole pipeline:\n"
     "  --pipeline            run mesh3d and print its verdict, tets, min dihedral, volume error\n"
     "  --quality             with --pipeline: sort the tets under --below DEG (default 10) by origin;\n"
@@ -233,7 +235,7 @@ int option_values(const std::string& a) {
       {"--optimize-sweeps", 1}, {"--outward", 1}, {"--peel-rounds", 1}, {"--smooth", 1},
       {"--target-dihedral", 1}, {"--thickness-extra", 1}, {"--thin-cells", 1}, {"--topology-refinements", 1}, {"--topology-gap", 1},
       {"--graze-region", 0}, {"--graze-length", 1}, {"--root-shift", 3}, {"--repair-at-cells", 0},
-      {"--untangle-reach", 1}, {"--backward-along", 1}};
+      {"--untangle-reach", 1}, {"--in-plane", 1}, {"--backward-along", 1}};
   for (const auto& [name, n] : known)
     if (a == name) return n;
   return -1;
@@ -288,6 +290,7 @@ int main(int argc, char** argv) {
     if (std::string(argv[i]) == "--all") bo.outward_all_faces = true;
     if (std::string(argv[i]) == "--norays") bo.rays = false;
     if (std::string(argv[i]) == "--unfold") bo.unfold_backward = true;
+    if (std::string(argv[i]) == "--in-plane") bo.in_plane_cosine = std::atof(argv[i + 1]);
     if (std::string(argv[i]) == "--graze-region") bo.graze_region = true;
     if (std::string(argv[i]) == "--snap") bo.snap_features = true;
     if (std::string(argv[i]) == "--near" && i + 4 < argc) {
@@ -312,6 +315,7 @@ int main(int argc, char** argv) {
   opt.outward_all_faces = bo.outward_all_faces;
   opt.projection_rays = bo.rays;
   opt.unfold_backward = bo.unfold_backward;
+  opt.in_plane_cosine = bo.in_plane_cosine;
   opt.graze_region = bo.graze_region;
   opt.graze_length = bo.graze_length;
   opt.backward_along = bo.backward_along;

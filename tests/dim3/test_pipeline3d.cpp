@@ -685,6 +685,65 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   CHECK(on < off);
 }
 
+// The steps of the interior octants' staircase (BoundaryOctantOptions::in_plane_cosine): where the
+// level changes along a flat face (the feature level near a box's edges) the interior region
+// has a step whose face stands square to the surface; the closest points of its nodes run in
+// the face's plane and its boundary octant is flat (diagnose3d on this box: 44, 109, 194 folded
+// boundary octants at levels 3, 4, 5). Along the summed normals of the nodes' free faces none
+// folds.
+TEST_CASE("step nodes projected along their free faces' summed normal fold no boundary octant of a box",
+          "[pipeline3d][boundary_octants]") {
+  TriangleSoup soup;
+  const P3 lo(0.013, 0.021, 0.037), size(1.0, 0.7, 0.45);
+  for (int k = 0; k < 8; ++k) soup.vertices.push_back(lo + P3(k & 1, (k >> 1) & 1, (k >> 2) & 1).cwiseProduct(size));
+  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) {
+    soup.triangles.push_back({f[0], f[1], f[2]});
+    soup.triangles.push_back({f[0], f[2], f[3]});
+  }
+  SurfaceBoundary s{Surface(soup)};
+  const SurfacePointFn sp = [&](const P3& p) {
+    const ClosestPoint<3> cp = s.closest_point(p);
+    return std::make_pair(P3(cp.point), cp.where);
+  };
+  for (int level : {3, 4}) {
+    s.set_global_level(level);
+    s.set_max_level(level + 2);
+    RefineOptions ro;
+    ro.max_level = level + 4;
+    const ControlFn<3> control = [&](const Box<3>& b) { return s.control_level(b); };
+    const Orthtree<3> tree = balance_2to1(subdivide_by_control(s.root_box(), control, ro), BalanceKind::Full);
+    Flags in = interior_flags(classify(tree, s));
+    remove_pinches(tree, in);
+    keep_largest_components(tree, in, s.n_components());
+    const auto raw_inverted = [&](double in_plane_cosine, std::size_t& n_rays) {
+      BoundaryOctantOptions bo;
+      bo.in_plane_cosine = in_plane_cosine;
+      const OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
+      REQUIRE(oc.problems.empty());
+      n_rays = oc.stats.n_ray;
+      const TetMesh fe = tetrahedralize(tree, oc.complex, sp);
+      std::size_t n = 0;
+      for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+        const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+        const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
+                 &d = fe.mesh.points[v[3].v];
+        n += (b - a).dot((c - a).cross(d - a)) > 0 ? 0 : 1;
+      }
+      return n;
+    };
+    std::size_t rays_off = 0, rays_on = 0;
+    const std::size_t off = raw_inverted(0.0, rays_off);
+    const std::size_t on = raw_inverted(0.01, rays_on);
+    INFO("level " << level << ": raw inverted tetrahedra by closest points " << off << ", along the summed normals "
+                  << on << " (" << rays_on << " rays)");
+    CHECK(off > 0);  // the box has steps: without the rule their octants fold
+    CHECK(rays_off == 0);
+    CHECK(rays_on > 0);
+    CHECK(on == 0);
+  }
+}
+
 // A run refused before it built a tree (the octants over Options3d::max_cells) has no work bound
 // for a lattice draw: none is made, and the refusal is the first lattice's, of the same type.
 TEST_CASE("mesh3d's lattice draws keep a refusal before any tree as it was", "[pipeline3d]") {
