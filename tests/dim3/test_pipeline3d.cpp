@@ -35,6 +35,29 @@ SurfaceBoundary boundary_of(const TriangleSoup& soup, const std::string& name) {
   return SurfaceBoundary(std::move(surface));
 }
 
+/// The boundary octants of the interior octants `in` with `bo`, tetrahedralized as the templates
+/// make them before any untangling: how many tetrahedra are inverted or flat. `stats` receives
+/// the construction's counts.
+std::size_t raw_inverted_tets(const Orthtree<3>& tree, const Flags& in, const SurfaceBoundary& s,
+                              const BoundaryOctantOptions& bo, BoundaryOctantStats& stats) {
+  const OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
+  REQUIRE(oc.problems.empty());
+  stats = oc.stats;
+  const SurfacePointFn sp = [&](const P3& p) {
+    const ClosestPoint<3> cp = s.closest_point(p);
+    return std::make_pair(P3(cp.point), cp.where);
+  };
+  const TetMesh fe = tetrahedralize(tree, oc.complex, sp);
+  std::size_t n = 0;
+  for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
+    const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
+    const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
+             &d = fe.mesh.points[v[3].v];
+    n += (b - a).dot((c - a).cross(d - a)) > 0 ? 0 : 1;
+  }
+  return n;
+}
+
 /// The options of a regression file's case: `level`, one thread, the file's own axes and one
 /// lattice: the regressions were found in them, and most are voxel unions at an angle, which
 /// mesh3d would mesh in the frame of their faces (Options3d::align_planar_faces); these tests
@@ -655,25 +678,13 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   }
   remove_pinches(tree, in);
   keep_largest_components(tree, in, s.n_components());
-  const SurfacePointFn sp = [&](const P3& p) {
-    const ClosestPoint<3> cp = s.closest_point(p);
-    return std::make_pair(P3(cp.point), cp.where);
-  };
   const auto raw_inverted = [&](bool unfold, std::size_t& n_unfolded) {
     BoundaryOctantOptions bo;
     bo.snap_features = false;
     bo.unfold_backward = unfold;
-    const OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
-    REQUIRE(oc.problems.empty());
-    n_unfolded = oc.stats.n_unfolded;
-    const TetMesh fe = tetrahedralize(tree, oc.complex, sp);
-    std::size_t n = 0;
-    for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
-      const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
-      const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
-               &d = fe.mesh.points[v[3].v];
-      n += (b - a).dot((c - a).cross(d - a)) > 0 ? 0 : 1;
-    }
+    BoundaryOctantStats stats;
+    const std::size_t n = raw_inverted_tets(tree, in, s, bo, stats);
+    n_unfolded = stats.n_unfolded;
     return n;
   };
   std::size_t moved_off = 0, moved_on = 0;
@@ -702,10 +713,6 @@ TEST_CASE("step nodes projected along their free faces' summed normal fold no bo
     soup.triangles.push_back({f[0], f[2], f[3]});
   }
   SurfaceBoundary s{Surface(soup)};
-  const SurfacePointFn sp = [&](const P3& p) {
-    const ClosestPoint<3> cp = s.closest_point(p);
-    return std::make_pair(P3(cp.point), cp.where);
-  };
   for (int level : {3, 4}) {
     s.set_global_level(level);
     s.set_max_level(level + 2);
@@ -719,17 +726,9 @@ TEST_CASE("step nodes projected along their free faces' summed normal fold no bo
     const auto raw_inverted = [&](double in_plane_cosine, std::size_t& n_rays) {
       BoundaryOctantOptions bo;
       bo.in_plane_cosine = in_plane_cosine;
-      const OctantComplexResult oc = build_octant_complex(tree, in, s, bo);
-      REQUIRE(oc.problems.empty());
-      n_rays = oc.stats.n_ray;
-      const TetMesh fe = tetrahedralize(tree, oc.complex, sp);
-      std::size_t n = 0;
-      for (std::size_t e = 0; e < fe.mesh.solid.size(); ++e) {
-        const VertexId* v = fe.mesh.solid.nodes(ElemId{static_cast<std::int32_t>(e)});
-        const P3 &a = fe.mesh.points[v[0].v], &b = fe.mesh.points[v[1].v], &c = fe.mesh.points[v[2].v],
-                 &d = fe.mesh.points[v[3].v];
-        n += (b - a).dot((c - a).cross(d - a)) > 0 ? 0 : 1;
-      }
+      BoundaryOctantStats stats;
+      const std::size_t n = raw_inverted_tets(tree, in, s, bo, stats);
+      n_rays = stats.n_ray;
       return n;
     };
     std::size_t rays_off = 0, rays_on = 0;
