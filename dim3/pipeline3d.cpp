@@ -248,20 +248,21 @@ namespace {
 
 /// One try after every other was refused: mesh3d_tries with `o` within its own work bound of
 /// o.effort first trees. The mesh (its n_octants_built counting `effort` too), or the refusal's
-/// reason in `why`.
+/// reason in `why`; `built`, when given, receives the octants the try built on either way.
 std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o, const Effort& effort,
-                                          std::string& why, const Progress3& progress) {
+                                          std::string& why, const Progress3& progress, std::size_t* built = nullptr) {
   Effort own;
+  std::optional<Result3d> t;
   try {
-    Result3d t = mesh3d_tries(s, o, own, progress);
-    t.n_octants_built = effort.used + own.used;
-    return t;
+    t = mesh3d_tries(s, o, own, progress);
+    t->n_octants_built = effort.used + own.used;
   } catch (const GeometryError& f) {
     why = f.what();
   } catch (const LimitError& f) {
     why = f.what();
   }
-  return std::nullopt;
+  if (built) *built = own.used;
+  return t;
 }
 
 }  // namespace
@@ -333,7 +334,7 @@ namespace {
 
 /// The refusal `e` of every other try (after `effort`): once more with the surface at the one
 /// level (Options3d::uniform_after_refusal), within its own work bound of opt.effort first
-/// trees; refused too, `e` with both reasons.
+/// trees (try_after_refusal; `effort` counts its octants); refused too, `e` with both reasons.
 Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
                                const Progress3& progress) {
   if (!opt.uniform_after_refusal || opt.extra_levels <= 0) throw e;
@@ -342,20 +343,14 @@ Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort&
     progress(std::string("refused (") + e.what() + "): once more with the surface at level " +
              std::to_string(opt.level) + " only (no curvature or feature levels)");
   effort.uniform_tried = true;
-  Effort own;
   std::string why;
-  try {
-    Result3d r = mesh3d_tries(s, uniform, own, progress);
-    effort.used += own.used;
-    r.n_octants_built = effort.used;
-    r.surface_uniform = true;
-    return r;
-  } catch (const GeometryError& f) {
-    why = f.what();
-  } catch (const LimitError& f) {
-    why = f.what();
+  std::size_t built = 0;
+  std::optional<Result3d> r = try_after_refusal(s, uniform, effort, why, progress, &built);
+  effort.used += built;
+  if (r) {
+    r->surface_uniform = true;
+    return std::move(*r);
   }
-  effort.used += own.used;
   throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) + " only: " + why);
 }
 

@@ -678,18 +678,13 @@ TEST_CASE("unfolding backward projections leaves fewer raw inverted tetrahedra",
   }
   remove_pinches(tree, in);
   keep_largest_components(tree, in, s.n_components());
-  const auto raw_inverted = [&](bool unfold, std::size_t& n_unfolded) {
-    BoundaryOctantOptions bo;
-    bo.snap_features = false;
-    bo.unfold_backward = unfold;
-    BoundaryOctantStats stats;
-    const std::size_t n = raw_inverted_tets(tree, in, s, bo, stats);
-    n_unfolded = stats.n_unfolded;
-    return n;
-  };
-  std::size_t moved_off = 0, moved_on = 0;
-  const std::size_t off = raw_inverted(false, moved_off);
-  const std::size_t on = raw_inverted(true, moved_on);
+  BoundaryOctantOptions bo;
+  bo.snap_features = false;
+  BoundaryOctantStats stats_off, stats_on;
+  const std::size_t off = raw_inverted_tets(tree, in, s, bo, stats_off);
+  bo.unfold_backward = true;
+  const std::size_t on = raw_inverted_tets(tree, in, s, bo, stats_on);
+  const std::size_t moved_off = stats_off.n_unfolded, moved_on = stats_on.n_unfolded;
   INFO("raw inverted tetrahedra without the rule " << off << ", with it " << on << " (" << moved_on << " moved)");
   CHECK(moved_off == 0);
   CHECK(moved_on > 0);
@@ -723,17 +718,13 @@ TEST_CASE("step nodes projected along their free faces' summed normal fold no bo
     Flags in = interior_flags(classify(tree, s));
     remove_pinches(tree, in);
     keep_largest_components(tree, in, s.n_components());
-    const auto raw_inverted = [&](double in_plane_cosine, std::size_t& n_rays) {
-      BoundaryOctantOptions bo;
-      bo.in_plane_cosine = in_plane_cosine;
-      BoundaryOctantStats stats;
-      const std::size_t n = raw_inverted_tets(tree, in, s, bo, stats);
-      n_rays = stats.n_ray;
-      return n;
-    };
-    std::size_t rays_off = 0, rays_on = 0;
-    const std::size_t off = raw_inverted(0.0, rays_off);
-    const std::size_t on = raw_inverted(0.01, rays_on);
+    BoundaryOctantOptions bo;
+    bo.in_plane_cosine = 0.0;
+    BoundaryOctantStats stats_off, stats_on;
+    const std::size_t off = raw_inverted_tets(tree, in, s, bo, stats_off);
+    bo.in_plane_cosine = 0.01;
+    const std::size_t on = raw_inverted_tets(tree, in, s, bo, stats_on);
+    const std::size_t rays_off = stats_off.n_ray, rays_on = stats_on.n_ray;
     INFO("level " << level << ": raw inverted tetrahedra by closest points " << off << ", along the summed normals "
                   << on << " (" << rays_on << " rays)");
     CHECK(off > 0);  // the box has steps: without the rule their octants fold
