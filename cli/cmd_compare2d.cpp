@@ -86,6 +86,7 @@ int run(const std::vector<std::string>& argv) {
   const std::string input = args.positional()[0];
   const std::string out = args.value("-o").value_or(args.value_or("--output", ""));
   if (out.empty()) throw UsageError("missing -o DIR");
+  check_output_folder(out);  // before the run: never replaces a folder febemesh did not write
   Options2d opt;
   opt.level = args.real_or("--level", no_level, 0, 20);
   const double size = size_option(args);

@@ -201,6 +201,7 @@ int run(const std::vector<std::string>& argv) {
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
   if (!out) throw UsageError("missing -o DIR");
+  check_output_folder(*out);  // before the run: never replaces a folder febemesh did not write
   dim3::Options3d opt;
   opt.level = args.int_or("--level", 4, 1, finest_level);
   opt.size = size_option(args);

@@ -279,3 +279,30 @@ TEST_CASE("mesh2d --size: the quadrants' side instead of a level; the count foll
   CHECK_FALSE(std::filesystem::exists(dir / "x"));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("mesh2d and mesh3d never replace a folder they did not write", "[cli][mesh2d][mesh3d]") {
+  namespace fs = std::filesystem;
+  const auto root = scratch("foreign");
+  fs::remove_all(root);
+  const fs::path mine = root / "work";
+  fs::create_directories(mine);
+  std::ofstream(mine / "thesis.tex") << "years of work";
+  const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
+  for (const std::string& args : {"mesh2d '" + flange + "' --level 5", "mesh3d '" + sphere + "' --level 3"}) {
+    const Run r = run(args + " -o '" + mine.string() + "' --quiet --threads 1");
+    INFO(args << "\n" << r.output);
+    CHECK(r.status == 1);
+    CHECK(r.output.find("error: output folder " + mine.string()) != std::string::npos);
+    CHECK(r.output.find("'thesis.tex'") != std::string::npos);
+    CHECK(r.output.find('\n') == r.output.size() - 1);  // one line
+    CHECK(read_text(mine / "thesis.tex") == "years of work");
+    CHECK(std::distance(fs::directory_iterator(root), fs::directory_iterator()) == 1);  // nothing beside it
+  }
+  // A folder of its own is replaced by the next run (the marker says whose it is).
+  const fs::path out = root / "out";
+  REQUIRE(run("mesh2d '" + flange + "' -o '" + out.string() + "' --level 5 --quiet --no-figures").status == 0);
+  CHECK(fs::exists(out / ".febemesh-output"));
+  REQUIRE(run("mesh2d '" + flange + "' -o '" + out.string() + "' --level 6 --quiet --no-figures").status == 0);
+  CHECK(fs::exists(out / "mesh.msh"));
+  fs::remove_all(root);
+}

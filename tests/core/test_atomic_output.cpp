@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "core/atomic_output.hpp"
+#include "core/error.hpp"
 
 using namespace febemesh;
 namespace fs = std::filesystem;
@@ -77,5 +78,77 @@ TEST_CASE("a trailing separator names the same folder", "[atomic_output]") {
   }
   CHECK(fs::is_directory(root / "out"));
   CHECK(n_entries(root) == 1);
+  fs::remove_all(root);
+}
+
+TEST_CASE("a folder febemesh did not write is never replaced", "[atomic_output]") {
+  const fs::path root = scratch();
+  const fs::path out = root / "work";
+  fs::create_directories(out / "thesis");
+  std::ofstream(out / "notes.txt") << "mine";
+  // Refused before the run, with the folder's name and one of the foreign entries.
+  try {
+    AtomicOutputDir dir(out);
+    FAIL("a user's folder was accepted as output");
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    CHECK(what.find(out.string()) != std::string::npos);
+    CHECK(what.find("did not write") != std::string::npos);
+    CHECK((what.find("'notes.txt'") != std::string::npos || what.find("'thesis'") != std::string::npos));
+  }
+  CHECK(fs::exists(out / "notes.txt"));
+  CHECK(fs::is_directory(out / "thesis"));
+  CHECK(n_entries(root) == 1);  // no temporary folder left
+  // A file in the folder's place is refused too, and kept.
+  std::ofstream(root / "file") << "x";
+  CHECK_THROWS_AS(AtomicOutputDir(root / "file"), InputError);
+  CHECK(fs::is_regular_file(root / "file"));
+  fs::remove_all(root);
+}
+
+TEST_CASE("a folder that becomes foreign during the run is kept at commit", "[atomic_output]") {
+  const fs::path root = scratch();
+  const fs::path out = root / "out";
+  {
+    AtomicOutputDir dir(out);
+    std::ofstream(dir.file("mesh.msh")) << "first";
+    dir.commit();
+  }
+  CHECK(fs::exists(out / std::string(kOutputMarker)));
+  {
+    AtomicOutputDir dir(out);  // febemesh's own folder: accepted
+    std::ofstream(dir.file("mesh.msh")) << "second";
+    // While the run goes on, someone replaces the folder with their own.
+    fs::remove_all(out);
+    fs::create_directories(out);
+    std::ofstream(out / "data.csv") << "1,2";
+    CHECK_THROWS_AS(dir.commit(), InputError);
+    CHECK_FALSE(dir.committed());
+  }
+  CHECK(fs::exists(out / "data.csv"));
+  CHECK(n_entries(root) == 1);  // the temporary folder removed
+  fs::remove_all(root);
+}
+
+TEST_CASE("an output folder of an earlier version, without the marker, is replaced", "[atomic_output]") {
+  const fs::path root = scratch();
+  const fs::path out = root / "out";
+  fs::create_directories(out / "figures");
+  for (const char* name : {"mesh.msh", "mesh.vtu", "report.json"}) std::ofstream(out / name) << "old";
+  {
+    AtomicOutputDir dir(out);
+    std::ofstream(dir.file("mesh.msh")) << "new";
+    dir.commit();
+  }
+  CHECK_FALSE(fs::exists(out / "report.json"));
+  CHECK(fs::exists(out / std::string(kOutputMarker)));
+  // An empty folder is taken too.
+  const fs::path empty = root / "empty";
+  fs::create_directories(empty);
+  {
+    AtomicOutputDir dir(empty);
+    dir.commit();
+  }
+  CHECK(fs::exists(empty / std::string(kOutputMarker)));
   fs::remove_all(root);
 }
