@@ -1,6 +1,6 @@
 // POSIX rename() is atomic for a folder onto a missing or empty target only, so an existing DIR
 // is first moved aside to DIR.old-<pid> and removed after the new folder is in place. Only a
-// folder febemesh wrote is ever replaced (replaceable_output): `-o ~/work` used to remove the
+// folder febemesh wrote is ever replaced (check_output_folder): `-o ~/work` used to remove the
 // whole of ~/work at the end of the run.
 
 #include "core/atomic_output.hpp"
