@@ -190,13 +190,13 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first",
+  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first", "--uniform-last",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary", "--no-figures"},
                   {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
                    "--max-cells",
                    "--lattice-draws", "--draw-below", "--draw-lost", "--draw-effort", "--target-dihedral",
-                   "--flat-buffer", "--flat-retry-below", "--figures"});
+                   "--flat-buffer", "--in-plane", "--flat-retry-below", "--figures"});
   args.expect_positional({"SURFACE"});
   const std::string input = args.positional()[0];
   const auto out = args.value("-o");
@@ -216,6 +216,9 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for comparisons with the order before session 31: the buffer rule's try first
   // (Options3d::buffer_last off).
   opt.buffer_last = !args.has("--buffer-first");
+  // Hidden, for comparisons with the order of session 51: on a faceted surface the try with the
+  // surface at one level after every other, not right after the first (Options3d::uniform_early_faceted off).
+  opt.uniform_early_faceted = !args.has("--uniform-last");
   // Hidden, for comparisons with the tries before session 32: no thickness try's first tree
   // after a first tree with problems (Options3d::thickness_probe off).
   opt.thickness_probe = !args.has("--no-thickness-probe");
@@ -223,6 +226,9 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for experiments: Options3d::flat_buffer (interior octants whose free face lies flat
   // within this x their size of the surface are dropped; 0, off, by default).
   opt.flat_buffer = args.real_or("--flat-buffer", opt.flat_buffer, 0.0, 0.5);
+  // Hidden, for experiments: Options3d::in_plane_cosine in every try (0, off, by default; the
+  // try with the surface at one level uses uniform_in_plane_cosine).
+  opt.in_plane_cosine = args.real_or("--in-plane", opt.in_plane_cosine, 0.0, 0.5);
   opt.effort = args.real_or("--effort", opt.effort, 1.0, 1000.0);
   opt.max_cells = static_cast<std::size_t>(args.real_or("--max-cells", static_cast<double>(opt.max_cells), 1e2, 1e10));
   opt.lattice_draws = args.int_or("--lattice-draws", opt.lattice_draws, 0, 2);

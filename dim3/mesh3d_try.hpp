@@ -31,6 +31,9 @@ struct Effort {
   /// The tries with the curvature and feature levels were refused and the run went on with the
   /// surface at the one level (Options3d::uniform_after_refusal): its lattice draws start there.
   bool uniform_tried = false;
+  /// Why that try was refused, when it ran early (Options3d::uniform_early_faceted) and was
+  /// refused: it is not run again after the others, whose refusal then gives this reason too.
+  std::string uniform_refused;
 };
 
 /// One try of the pipeline with `opt` (no fallback): `s` gets the options' levels, `effort`

@@ -90,6 +90,9 @@ const ValidationReport& validation_of(Result3d& r, const SurfaceBoundary& s, int
 
 namespace {
 
+std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
+                                      const Progress3& progress);
+
 Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   const auto buffer = [&](const Options3d& o) { return mesh3d_buffer(s, o, effort, progress); };
   if (!opt.retry_facing) return buffer(opt);
@@ -111,7 +114,15 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   Options3d plain = opt;
   plain.buffer = 0.0;
   try {
-    return with_fallback(features, plain, facing, "with facing projections only", &Result3d::facing_projection, progress);
+    try {
+      return features(plain);
+    } catch (const GeometryError& e) {
+      if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, progress)) return std::move(*u);
+      if (progress) progress(std::string("with facing projections only, after: ") + e.what());
+      Result3d r = features(facing);
+      r.facing_projection = true;
+      return r;
+    }
   } catch (const GeometryError& e) {
     if (progress) progress(std::string("with the buffer rule, after: ") + e.what());
     Result3d r = features(opt);
@@ -253,8 +264,10 @@ std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o
                                           std::string& why, const Progress3& progress, std::size_t* built = nullptr) {
   Effort own;
   std::optional<Result3d> t;
+  Options3d tried = o;
+  tried.uniform_early_faceted = false;  // a run's own chain only
   try {
-    t = mesh3d_tries(s, o, own, progress);
+    t = mesh3d_tries(s, tried, own, progress);
     t->n_octants_built = effort.used + own.used;
   } catch (const GeometryError& f) {
     why = f.what();
@@ -338,6 +351,9 @@ namespace {
 Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
                                const Progress3& progress) {
   if (!opt.uniform_after_refusal || opt.extra_levels <= 0) throw e;
+  if (!effort.uniform_refused.empty())  // it ran early (uniform_early) and was refused
+    throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) +
+                        " only: " + effort.uniform_refused);
   const Options3d uniform = uniform_try_options(opt);
   if (progress)
     progress(std::string("refused (") + e.what() + "): once more with the surface at level " +
@@ -352,6 +368,35 @@ Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort&
     return std::move(*r);
   }
   throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) + " only: " + why);
+}
+
+/// The first try's refusal `e` on a faceted surface (Options3d::uniform_early_faceted): the try
+/// with the surface at the one level at once, within its own work bound (`effort` counts its
+/// octants and remembers the refusal, so that uniform_after_refusal does not run it again).
+/// Empty where it does not apply or was refused.
+std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
+                                      const Progress3& progress) {
+  const Features& f = s.features();
+  const bool faceted = opt.snap_features && f.n_feature_edges() > 0 && f.free_end_share() > opt.faceted_free_ends;
+  if (!opt.uniform_early_faceted || !opt.uniform_after_refusal || opt.extra_levels <= 0 || !faceted ||
+      effort.uniform_tried)
+    return std::nullopt;
+  const Options3d uniform = uniform_try_options(opt);
+  if (progress)
+    progress(std::string("refused (") + e.what() + "): a faceted surface, so at once with the surface at level " +
+             std::to_string(opt.level) + " only (no curvature or feature levels)");
+  effort.uniform_tried = true;
+  std::string why;
+  std::size_t built = 0;
+  std::optional<Result3d> r = try_after_refusal(s, uniform, effort, why, progress, &built);
+  effort.used += built;
+  if (r) {
+    r->surface_uniform = true;
+    return r;
+  }
+  effort.uniform_refused = why;
+  if (progress) progress("with the surface at level " + std::to_string(opt.level) + " only: refused (" + why + ")");
+  return std::nullopt;
 }
 
 /// mesh3d in the surface's own axes: the tries, the fallbacks after a refusal (unless
@@ -402,6 +447,7 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
   if (progress)
     progress("volume error " + std::to_string(100 * error) + "%: once more with " + octants_across(thin.thickness_cells) +
              " the thin parts, without the buffer rule");
+  thin.uniform_early_faceted = false;  // a run's own chain only
   Effort thin_effort;
   try {
     Result3d t = mesh3d_tries(s, thin, thin_effort, progress);
@@ -659,7 +705,11 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     // the refused tries cost the most (examples/3d/flange.stl level 6: 89 s of its first draw's
     // 95 s; started there, the draw made the same mesh in 7.5 s; docs/measurements.md, session
     // 51).
-    const bool uniform_draw = p.draw > 0 && runs.back().effort.uniform_tried && o.extra_levels > 0;
+    // (Not after a run whose early try at the one level was refused and whose later tries stood:
+    // Options3d::uniform_early_faceted.)
+    const Drawn& last = runs.back();
+    const bool uniform_draw =
+        p.draw > 0 && last.effort.uniform_tried && (!last.r || last.r->surface_uniform) && o.extra_levels > 0;
     if (uniform_draw) {
       o = uniform_try_options(o);
       if (progress) progress("lattice draw " + std::to_string(p.draw) + ": with the surface at level " +

@@ -242,6 +242,17 @@ struct Options3d {
   /// try in 69.5 s (457,543 tets, 27.11 deg); the block is valid at levels 4-6 (refused or
   /// invalid before), the tee at level 6 (15.17 deg, 232 s).
   bool uniform_after_refusal = true;
+  /// On a faceted surface (faceted_free_ends), that try (uniform_after_refusal) comes right
+  /// after the first try is refused, before the facing projections' and the buffer rule's
+  /// tries with the curvature and feature levels, and is not run again at the end; where it is
+  /// refused too, the tries go on in their order. Only in a run's own chain of tries (not in
+  /// the thickness, thin-parts-coarse or thin retries). A faceted surface's feature lines are
+  /// not snapped to, and the levels' steps along its flat faces fold the first tree: the
+  /// parts' first trees at level 6 had 8,496 (block) and 15,201 (flange) raw inverted
+  /// tetrahedra with the levels and 463 (block) at the one level, whose try stood where those
+  /// with the levels were refused after 68 s (block L6; session 52). Off: the order of session
+  /// 51 (mesh3d --uniform-last).
+  bool uniform_early_faceted = true;
   /// in_plane_cosine in that try: there the level no longer changes along the surface, and
   /// its steps are those of the thickness level and the repairs (examples/3d/block.stl level 6
   /// stood there with it, session 51).
