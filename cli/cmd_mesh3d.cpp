@@ -190,7 +190,7 @@ Mesh<3> triangulated_interface(const Mesh<3>& m) {
 }
 
 int run(const std::vector<std::string>& argv) {
-  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first", "--uniform-last",
+  const Args args(argv, {"--quiet", "--no-features", "--features-fallback-first", "--buffer-first", "--uniform-last", "--uniform-before-unsnapped",
                    "--no-thickness-probe", "--given-axes", "--allow-invalid",
                    "--binary", "--no-figures"},
                   {"-o", "--level", "--size", "--extra-levels", "--elements", "--buffer", "--smooth", "--threads", "--effort",
@@ -219,6 +219,7 @@ int run(const std::vector<std::string>& argv) {
   // Hidden, for comparisons with the order of session 51: on a faceted surface the try with the
   // surface at one level after every other, not right after the first (Options3d::uniform_early_faceted off).
   opt.uniform_early_faceted = !args.has("--uniform-last");
+  opt.uniform_early_snapped = args.has("--uniform-before-unsnapped");  // hidden, an experiment
   // Hidden, for comparisons with the tries before session 32: no thickness try's first tree
   // after a first tree with problems (Options3d::thickness_probe off).
   opt.thickness_probe = !args.has("--no-thickness-probe");

@@ -91,7 +91,7 @@ const ValidationReport& validation_of(Result3d& r, const SurfaceBoundary& s, int
 namespace {
 
 std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
-                                      const Progress3& progress);
+                                      bool snapped, const Progress3& progress);
 
 Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   const auto buffer = [&](const Options3d& o) { return mesh3d_buffer(s, o, effort, progress); };
@@ -117,7 +117,7 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
     try {
       return features(plain);
     } catch (const GeometryError& e) {
-      if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, progress)) return std::move(*u);
+      if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, false, progress)) return std::move(*u);
       if (progress) progress(std::string("with facing projections only, after: ") + e.what());
       Result3d r = features(facing);
       r.facing_projection = true;
@@ -141,8 +141,15 @@ Result3d mesh3d_tries(SurfaceBoundary& s, const Options3d& opt, Effort& effort, 
   if (!opt.features_fallback_last || !snaps) return facing(opt);
   Options3d plain = opt;
   plain.snap_features = false;
-  return with_fallback(facing, opt, plain, "without feature snapping, every try", &Result3d::features_dropped,
-                       progress);
+  try {
+    return facing(opt);
+  } catch (const GeometryError& e) {
+    if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, true, progress)) return std::move(*u);
+    if (progress) progress(std::string("without feature snapping, every try, after: ") + e.what());
+    Result3d r = facing(plain);
+    r.features_dropped = true;
+    return r;
+  }
 }
 
 }  // namespace
@@ -265,7 +272,7 @@ std::optional<Result3d> try_after_refusal(SurfaceBoundary& s, const Options3d& o
   Effort own;
   std::optional<Result3d> t;
   Options3d tried = o;
-  tried.uniform_early_faceted = false;  // a run's own chain only
+  tried.uniform_early_faceted = tried.uniform_early_snapped = false;  // a run's own chain only
   try {
     t = mesh3d_tries(s, tried, own, progress);
     t->n_octants_built = effort.used + own.used;
@@ -370,20 +377,21 @@ Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort&
   throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) + " only: " + why);
 }
 
-/// The first try's refusal `e` on a faceted surface (Options3d::uniform_early_faceted): the try
-/// with the surface at the one level at once, within its own work bound (`effort` counts its
-/// octants and remembers the refusal, so that uniform_after_refusal does not run it again).
-/// Empty where it does not apply or was refused.
+/// The refusal `e` of the first try on a faceted surface (Options3d::uniform_early_faceted) or,
+/// `snapped`, of every try with feature snapping on one whose feature lines are snapped to
+/// (Options3d::uniform_early_snapped): the try with the surface at the one level at once, within
+/// its own work bound (`effort` counts its octants and remembers the refusal, so that
+/// uniform_after_refusal does not run it again). Empty where it does not apply or was refused.
 std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
-                                      const Progress3& progress) {
+                                      bool snapped, const Progress3& progress) {
   const Features& f = s.features();
   const bool faceted = opt.snap_features && f.n_feature_edges() > 0 && f.free_end_share() > opt.faceted_free_ends;
-  if (!opt.uniform_early_faceted || !opt.uniform_after_refusal || opt.extra_levels <= 0 || !faceted ||
-      effort.uniform_tried)
-    return std::nullopt;
+  const bool applies = snapped ? opt.uniform_early_snapped : opt.uniform_early_faceted && faceted;
+  if (!applies || !opt.uniform_after_refusal || opt.extra_levels <= 0 || effort.uniform_tried) return std::nullopt;
   const Options3d uniform = uniform_try_options(opt);
   if (progress)
-    progress(std::string("refused (") + e.what() + "): a faceted surface, so at once with the surface at level " +
+    progress(std::string("refused (") + e.what() + "): " +
+             (snapped ? "every try with feature snapping" : "a faceted surface") + ", so at once with the surface at level " +
              std::to_string(opt.level) + " only (no curvature or feature levels)");
   effort.uniform_tried = true;
   std::string why;
@@ -447,7 +455,7 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
   if (progress)
     progress("volume error " + std::to_string(100 * error) + "%: once more with " + octants_across(thin.thickness_cells) +
              " the thin parts, without the buffer rule");
-  thin.uniform_early_faceted = false;  // a run's own chain only
+  thin.uniform_early_faceted = thin.uniform_early_snapped = false;  // a run's own chain only
   Effort thin_effort;
   try {
     Result3d t = mesh3d_tries(s, thin, thin_effort, progress);
@@ -707,9 +715,8 @@ Result3d mesh3d(SurfaceBoundary& s, const Options3d& opt_in, const Progress3& pr
     // 51).
     // (Not after a run whose early try at the one level was refused and whose later tries stood:
     // Options3d::uniform_early_faceted.)
-    const Drawn& last = runs.back();
-    const bool uniform_draw =
-        p.draw > 0 && last.effort.uniform_tried && (!last.r || last.r->surface_uniform) && o.extra_levels > 0;
+    const bool uniform_draw = p.draw > 0 && !runs.empty() && runs.back().effort.uniform_tried &&
+                              (!runs.back().r || runs.back().r->surface_uniform) && o.extra_levels > 0;
     if (uniform_draw) {
       o = uniform_try_options(o);
       if (progress) progress("lattice draw " + std::to_string(p.draw) + ": with the surface at level " +

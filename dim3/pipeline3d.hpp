@@ -253,6 +253,13 @@ struct Options3d {
   /// with the levels were refused after 68 s (block L6; session 52). Off: the order of session
   /// 51 (mesh3d --uniform-last).
   bool uniform_early_faceted = true;
+  /// On a surface whose feature lines are snapped to, that try comes after every try with
+  /// snapping is refused, before the tries without it (features_fallback_last). Off: an
+  /// experiment (mesh3d --uniform-before-unsnapped). Measured (session 52, CLI, one thread,
+  /// beside other runs): examples/3d/tee.stl level 6 the same mesh in 185 s wall instead of
+  /// about 300, but rotor L6's one-level try ran 300 s before it was refused, and the run with it
+  /// took longer than without it (the tries without snapping then stopped at the work bound).
+  bool uniform_early_snapped = false;
   /// in_plane_cosine in that try: there the level no longer changes along the surface, and
   /// its steps are those of the thickness level and the repairs (examples/3d/block.stl level 6
   /// stood there with it, session 51).
