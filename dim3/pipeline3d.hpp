@@ -256,9 +256,12 @@ struct Options3d {
   /// On a surface whose feature lines are snapped to, that try comes after every try with
   /// snapping is refused, before the tries without it (features_fallback_last). Off: an
   /// experiment (mesh3d --uniform-before-unsnapped). Measured (session 52, CLI, one thread,
-  /// beside other runs): examples/3d/tee.stl level 6 the same mesh in 185 s wall instead of
-  /// about 300, but rotor L6's one-level try ran 300 s before it was refused, and the run with it
-  /// took longer than without it (the tries without snapping then stopped at the work bound).
+  /// beside the CI run): examples/3d/tee.stl level 6 the same mesh in 139 s CPU (197 s in the
+  /// parts sweep without it); rotor L6 the same mesh in 666 s CPU (569-712 s before): its
+  /// one-level try ran about 300 s and was refused, and the tries without snapping after it
+  /// stopped at once at the work bound. Not yet the default: the runs whose tries with
+  /// snapping are refused and whose tries without it stand (none in the README's tables) would
+  /// change.
   bool uniform_early_snapped = false;
   /// in_plane_cosine in that try: there the level no longer changes along the surface, and
   /// its steps are those of the thickness level and the repairs (examples/3d/block.stl level 6
