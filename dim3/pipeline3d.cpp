@@ -352,59 +352,60 @@ Options3d uniform_try_options(const Options3d& opt) {
 
 namespace {
 
+/// The try with the surface at the one level (uniform_try_options), within its own work bound
+/// of opt.effort first trees (try_after_refusal); `effort` counts its octants and notes that it
+/// ran (Effort::uniform_tried). The mesh (Result3d::surface_uniform), or the refusal's reason
+/// in `why`.
+std::optional<Result3d> uniform_try(SurfaceBoundary& s, const Options3d& opt, Effort& effort, std::string& why,
+                                    const Progress3& progress) {
+  effort.uniform_tried = true;
+  std::size_t built = 0;
+  std::optional<Result3d> r = try_after_refusal(s, uniform_try_options(opt), effort, why, progress, &built);
+  effort.used += built;
+  if (r) r->surface_uniform = true;
+  return r;
+}
+
+std::string only_at_level(int level) { return "with the surface at level " + std::to_string(level) + " only"; }
+
 /// The refusal `e` of every other try (after `effort`): once more with the surface at the one
-/// level (Options3d::uniform_after_refusal), within its own work bound of opt.effort first
-/// trees (try_after_refusal; `effort` counts its octants); refused too, `e` with both reasons.
+/// level (Options3d::uniform_after_refusal; uniform_try) unless that ran early (uniform_early);
+/// refused too, `e` with both reasons.
 Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
                                const Progress3& progress) {
   if (!opt.uniform_after_refusal || opt.extra_levels <= 0) throw e;
-  if (!effort.uniform_refused.empty())  // it ran early (uniform_early) and was refused
-    throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) +
-                        " only: " + effort.uniform_refused);
-  const Options3d uniform = uniform_try_options(opt);
+  if (!effort.uniform_refused.empty())  // it ran early and was refused
+    throw GeometryError(std::string(e.what()) + "; " + only_at_level(opt.level) + ": " + effort.uniform_refused);
   if (progress)
-    progress(std::string("refused (") + e.what() + "): once more with the surface at level " +
-             std::to_string(opt.level) + " only (no curvature or feature levels)");
-  effort.uniform_tried = true;
+    progress(std::string("refused (") + e.what() + "): once more " + only_at_level(opt.level) +
+             " (no curvature or feature levels)");
   std::string why;
-  std::size_t built = 0;
-  std::optional<Result3d> r = try_after_refusal(s, uniform, effort, why, progress, &built);
-  effort.used += built;
-  if (r) {
-    r->surface_uniform = true;
-    return std::move(*r);
-  }
-  throw GeometryError(std::string(e.what()) + "; with the surface at level " + std::to_string(opt.level) + " only: " + why);
+  if (std::optional<Result3d> r = uniform_try(s, opt, effort, why, progress)) return std::move(*r);
+  throw GeometryError(std::string(e.what()) + "; " + only_at_level(opt.level) + ": " + why);
 }
 
 /// The refusal `e` of the first try on a faceted surface (Options3d::uniform_early_faceted) or,
 /// `snapped`, of every try with feature snapping on one whose feature lines are snapped to
-/// (Options3d::uniform_early_snapped): the try with the surface at the one level at once, within
-/// its own work bound (`effort` counts its octants and remembers the refusal, so that
-/// uniform_after_refusal does not run it again). Empty where it does not apply or was refused.
+/// (Options3d::uniform_early_snapped): uniform_try at once (`effort` remembers a refusal, so
+/// that uniform_after_refusal does not run it again). Empty where it does not apply or was
+/// refused.
 std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
                                       bool snapped, const Progress3& progress) {
   const Features& f = s.features();
   const bool faceted = opt.snap_features && f.n_feature_edges() > 0 && f.free_end_share() > opt.faceted_free_ends;
   const bool applies = snapped ? opt.uniform_early_snapped : opt.uniform_early_faceted && faceted;
   if (!applies || !opt.uniform_after_refusal || opt.extra_levels <= 0 || effort.uniform_tried) return std::nullopt;
-  const Options3d uniform = uniform_try_options(opt);
   if (progress)
     progress(std::string("refused (") + e.what() + "): " +
-             (snapped ? "every try with feature snapping" : "a faceted surface") + ", so at once with the surface at level " +
-             std::to_string(opt.level) + " only (no curvature or feature levels)");
-  effort.uniform_tried = true;
+             (snapped ? "every try with feature snapping" : "a faceted surface") + ", so at once " +
+             only_at_level(opt.level) + " (no curvature or feature levels)");
   std::string why;
-  std::size_t built = 0;
-  std::optional<Result3d> r = try_after_refusal(s, uniform, effort, why, progress, &built);
-  effort.used += built;
-  if (r) {
-    r->surface_uniform = true;
-    return r;
+  std::optional<Result3d> r = uniform_try(s, opt, effort, why, progress);
+  if (!r) {
+    effort.uniform_refused = why;
+    if (progress) progress(only_at_level(opt.level) + ": refused (" + why + ")");
   }
-  effort.uniform_refused = why;
-  if (progress) progress("with the surface at level " + std::to_string(opt.level) + " only: refused (" + why + ")");
-  return std::nullopt;
+  return r;
 }
 
 /// mesh3d in the surface's own axes: the tries, the fallbacks after a refusal (unless
