@@ -34,7 +34,8 @@ Bezier pieces of every loop), both with the same element kind, choosing Gmsh's m
 its element count is within the tolerance of ours, and measures both meshes with the same code.
 
 options:
-  -o, --output DIR   output folder (written atomically; replaced if it exists)
+  -o, --output DIR   output folder (written atomically; an earlier run's folder is
+                     replaced, a folder holding other files refused)
   --level N          febemesh's level at the curve (default: the file's levels, else automatic)
   --size H           instead of --level: febemesh's quadrant side at the curve (as mesh2d's)
   --elements KIND    tri (default) | quad | mixed. Gmsh: tri = its default triangles; mixed =

@@ -32,7 +32,8 @@ Meshes the solid bounded by SURFACE (OFF, STL, OBJ, PLY) with febemesh (mesh3d) 
 count is within the tolerance of ours, and measures both meshes with the same code.
 
 options:
-  -o, --output DIR   output folder (written atomically; replaced if it exists)
+  -o, --output DIR   output folder (written atomically; an earlier run's folder is
+                     replaced, a folder holding other files refused)
   --level N          febemesh's octree level at the surface (1..9, default 4)
   --size H           instead of --level: febemesh's octant side at the surface (as mesh3d's)
   --extra-levels N   curvature and feature levels above it (0..4, default 2)

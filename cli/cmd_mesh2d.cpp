@@ -43,7 +43,8 @@ projection onto the curve, corner pulling, Laplacian smoothing, a BE mesh on the
 mesh from templates that share its nodes.
 
 options:
-  -o, --output DIR      output folder (written atomically; replaced if it exists)
+  -o, --output DIR      output folder (written atomically; an earlier run's folder is
+                        replaced, a folder holding other files refused)
   --level N             mesh control level at the curve (quadrant size = root / 2^N); default:
                         the file's levels, else automatic from curvature and thickness
   --size H              instead of --level: the quadrants' side at the curve, in the input's
