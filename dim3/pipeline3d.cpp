@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -19,14 +20,20 @@
 namespace febemesh::dim3 {
 namespace {
 
+/// What may stand between a try's refusal and its fallback (uniform_early): a mesh, or none.
+using BeforeFallback = std::function<std::optional<Result3d>(const GeometryError&)>;
+
 /// run(opt), and when that throws GeometryError, once more with `fallback` (the same input and
-/// the same fallback, so still deterministic), reporting why and setting `dropped`.
+/// the same fallback, so still deterministic), reporting why and setting `dropped`; `before`,
+/// when given, first, and its mesh stands if it makes one.
 template <typename Run>
 Result3d with_fallback(const Run& run, const Options3d& opt, const Options3d& fallback, const std::string& what,
-                       bool Result3d::*dropped, const Progress3& progress) {
+                       bool Result3d::*dropped, const Progress3& progress, const BeforeFallback& before = {}) {
   try {
     return run(opt);
   } catch (const GeometryError& e) {
+    if (before)
+      if (std::optional<Result3d> r = before(e)) return std::move(*r);
     if (progress) progress(what + ", after: " + e.what());
     Result3d r = run(fallback);
     r.*dropped = true;
@@ -114,15 +121,8 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
   Options3d plain = opt;
   plain.buffer = 0.0;
   try {
-    try {
-      return features(plain);
-    } catch (const GeometryError& e) {
-      if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, false, progress)) return std::move(*u);
-      if (progress) progress(std::string("with facing projections only, after: ") + e.what());
-      Result3d r = features(facing);
-      r.facing_projection = true;
-      return r;
-    }
+    return with_fallback(features, plain, facing, "with facing projections only", &Result3d::facing_projection, progress,
+                         [&](const GeometryError& e) { return uniform_early(s, opt, effort, e, false, progress); });
   } catch (const GeometryError& e) {
     if (progress) progress(std::string("with the buffer rule, after: ") + e.what());
     Result3d r = features(opt);
@@ -141,15 +141,8 @@ Result3d mesh3d_tries(SurfaceBoundary& s, const Options3d& opt, Effort& effort, 
   if (!opt.features_fallback_last || !snaps) return facing(opt);
   Options3d plain = opt;
   plain.snap_features = false;
-  try {
-    return facing(opt);
-  } catch (const GeometryError& e) {
-    if (std::optional<Result3d> u = uniform_early(s, opt, effort, e, true, progress)) return std::move(*u);
-    if (progress) progress(std::string("without feature snapping, every try, after: ") + e.what());
-    Result3d r = facing(plain);
-    r.features_dropped = true;
-    return r;
-  }
+  return with_fallback(facing, opt, plain, "without feature snapping, every try", &Result3d::features_dropped, progress,
+                       [&](const GeometryError& e) { return uniform_early(s, opt, effort, e, true, progress); });
 }
 
 }  // namespace
