@@ -9,7 +9,8 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
-#include <unistd.h>
+
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -17,12 +18,6 @@ int run_status(const std::string& args) {
   const std::string cmd = std::string("'") + FEBEMESH_CLI + "' " + args + " >/dev/null 2>&1";
   const int st = std::system(cmd.c_str());
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-std::filesystem::path tmp_dir() {
-  const auto d = std::filesystem::temp_directory_path() / ("febemesh_compare3d_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
 }
 
 std::string sphere() { return std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off"; }
@@ -42,7 +37,8 @@ std::string read_text(const std::filesystem::path& p) {
 }  // namespace
 
 TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both tools", "[cli][compare]") {
-  const auto out = tmp_dir() / "sphere";
+  const febemesh::test::ScratchDir dir("compare3d_cli");
+  const auto out = dir.path() / "sphere";
   REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 4 --quiet") == 0);
   const auto j = read_json(out / "comparison.json");
   for (const char* tool : {"febemesh", "tetgen"}) {
@@ -91,12 +87,12 @@ TEST_CASE("compare3d on sphere966 matches TetGen's tet count and reports both to
     return svg.substr(at, svg.find(':', at) - at);
   };
   CHECK(plane("febemesh-section-z.svg") == plane("tetgen-section-z.svg"));
-  std::filesystem::remove_all(out);
 }
 
 TEST_CASE("compare3d warns when TetGen cannot come down to our tet count", "[cli][compare]") {
   // At level 3 we make ~2,800 tets; TetGen's smallest mesh of the 966 input triangles is ~4x more.
-  const auto out = tmp_dir() / "coarse";
+  const febemesh::test::ScratchDir dir("compare3d_cli");
+  const auto out = dir.path() / "coarse";
   // (With a lower optimisation aim, passed on to mesh3d: --target-dihedral; and level 3 asked as
   // its octant's size, 21 / 8 in the default root cube: --size, the same mesh as --level 3.)
   REQUIRE(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --size 2.625 --target-dihedral 20 --quiet") == 0);
@@ -109,11 +105,11 @@ TEST_CASE("compare3d warns when TetGen cannot come down to our tet count", "[cli
   CHECK(j["element_count_ratio"].get<double>() > 1.2);
   CHECK(j["element_count_within_tolerance"] == false);
   CHECK(read_text(out / "comparison.md").find("**Warning:** tetgen's element count is") != std::string::npos);
-  std::filesystem::remove_all(out);
 }
 
 TEST_CASE("compare3d refuses bad input and bad usage", "[cli][compare]") {
-  const auto dir = tmp_dir();
+  const febemesh::test::ScratchDir scratch("compare3d_cli");
+  const auto& dir = scratch.path();
   const auto out = dir / "open";
   // Not closed: exit 1 and nothing written.
   CHECK(run_status("compare3d '" + std::string(FEBEMESH_DATA_DIR) + "/3d/open-cylinder.off' -o '" + out.string() +
@@ -127,5 +123,4 @@ TEST_CASE("compare3d refuses bad input and bad usage", "[cli][compare]") {
   CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --level 3 --size 2") == 2);
   CHECK(run_status("compare3d '" + sphere() + "' -o '" + out.string() + "' --frobnicate") == 2);
   CHECK(!std::filesystem::exists(out));
-  std::filesystem::remove_all(dir);
 }

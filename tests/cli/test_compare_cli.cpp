@@ -10,7 +10,8 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
-#include <unistd.h>
+
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -22,12 +23,6 @@ int run_status(const std::string& args) {
 
 bool have_gmsh() { return std::system("gmsh --version >/dev/null 2>&1") == 0; }
 
-std::filesystem::path tmp_dir() {
-  const auto d = std::filesystem::temp_directory_path() / ("febemesh_compare_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d;
-}
-
 }  // namespace
 
 TEST_CASE("compare2d on the flange matches Gmsh's element count and reports both tools", "[cli][compare]") {
@@ -35,7 +30,8 @@ TEST_CASE("compare2d on the flange matches Gmsh's element count and reports both
     WARN("gmsh is not installed: compare2d test skipped");
     return;
   }
-  const auto out = tmp_dir() / "flange";
+  const febemesh::test::ScratchDir dir("compare_cli");
+  const auto out = dir.path() / "flange";
   const int status =
       run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json' -o '" + out.string() +
                  "' --level 4 --quiet");
@@ -83,11 +79,11 @@ TEST_CASE("compare2d on the flange matches Gmsh's element count and reports both
     CHECK(counted == j[tool]["elements"].get<std::size_t>());
     CHECK(md.str().find("[" + name + "](" + name + ")") != std::string::npos);
   }
-  std::filesystem::remove_all(out.parent_path());
 }
 
 TEST_CASE("compare2d reports a failing Gmsh and exits with status 1", "[cli][compare]") {
-  const auto out = tmp_dir() / "nogmsh";
+  const febemesh::test::ScratchDir dir("compare_cli");
+  const auto out = dir.path() / "nogmsh";
   const int status = run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json' -o '" +
                                 out.string() + "' --level 3 --quiet --gmsh /nonexistent/gmsh");
   CHECK(status == 1);
@@ -99,7 +95,6 @@ TEST_CASE("compare2d reports a failing Gmsh and exits with status 1", "[cli][com
   CHECK(j["gmsh"]["error"].get<std::string>().find("/nonexistent/gmsh") != std::string::npos);
   CHECK(std::filesystem::exists(out / "febemesh-mesh.svg"));
   CHECK(!std::filesystem::exists(out / "gmsh-mesh.svg"));
-  std::filesystem::remove_all(out.parent_path());
 }
 
 TEST_CASE("compare2d --elements quad and mixed use Gmsh's recombination", "[cli][compare]") {
@@ -107,9 +102,10 @@ TEST_CASE("compare2d --elements quad and mixed use Gmsh's recombination", "[cli]
     WARN("gmsh is not installed: compare2d test skipped");
     return;
   }
+  const febemesh::test::ScratchDir dir("compare_cli");
   for (const std::string kind : {"quad", "mixed"}) {
     INFO(kind);
-    const auto out = tmp_dir() / kind;
+    const auto out = dir.path() / kind;
     REQUIRE(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json' -o '" +
                        out.string() + "' --level 4 --quiet --elements " + kind) == 0);
     std::ifstream in(out / "comparison.json");
@@ -133,18 +129,19 @@ TEST_CASE("compare2d --elements quad and mixed use Gmsh's recombination", "[cli]
     CHECK(ss.str().find("Mesh.RecombineAll = 1;") != std::string::npos);
     CHECK((ss.str().find("Mesh.SubdivisionAlgorithm = 1;") != std::string::npos) == (kind == "quad"));
   }
-  std::filesystem::remove_all(tmp_dir());
 }
 
 TEST_CASE("compare2d refuses bad usage and bad input", "[cli][compare]") {
+  const febemesh::test::ScratchDir dir("compare_cli");
+  const std::string never = (dir.path() / "never").string();
   CHECK(run_status("compare2d") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
-                   "/examples/flange.json' -o /tmp/febemesh_compare_never --elements hex") == 2);
+                   "/examples/flange.json' -o '" + never + "' --elements hex") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR + "/examples/flange.json'") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
-                   "/examples/flange.json' -o /tmp/febemesh_compare_never --level 6 --size 0.1") == 2);
+                   "/examples/flange.json' -o '" + never + "' --level 6 --size 0.1") == 2);
   CHECK(run_status(std::string("compare2d '") + FEBEMESH_SOURCE_DIR +
-                   "/examples/flange.json' -o /tmp/febemesh_compare_never --size 1e-9") == 2);  // past level 20
-  CHECK(run_status("compare2d /nonexistent.json -o /tmp/febemesh_compare_never") == 1);
-  CHECK(!std::filesystem::exists("/tmp/febemesh_compare_never"));
+                   "/examples/flange.json' -o '" + never + "' --size 1e-9") == 2);  // past level 20
+  CHECK(run_status("compare2d /nonexistent.json -o '" + never + "'") == 1);
+  CHECK(!std::filesystem::exists(never));
 }

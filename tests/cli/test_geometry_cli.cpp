@@ -11,6 +11,8 @@
 #include <string>
 #include <sys/wait.h>
 
+#include "scratch_dir.hpp"
+
 namespace {
 
 struct Run {
@@ -37,12 +39,6 @@ std::string slurp(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-std::string tmp_dir() {
-  const auto d = std::filesystem::temp_directory_path() / ("febemesh_geometry_cli_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(d);
-  return d.string();
 }
 
 }  // namespace
@@ -72,8 +68,8 @@ TEST_CASE("geometry prints the loops of a native example", "[cli][geometry]") {
 }
 
 TEST_CASE("geometry of a shared glyph and its drawing", "[cli][geometry]") {
-  const std::string svg = tmp_dir() + "/eight.svg";
-  std::filesystem::remove(svg);
+  const febemesh::test::ScratchDir dir("geometry_cli");
+  const std::string svg = (dir.path() / "eight.svg").string();
   const Run r = run(std::string("geometry '") + FEBEMESH_DATA_DIR + "/2d/DejaVuSans-U0038.svg' --svg '" + svg + "'");
   REQUIRE(r.status == 0);
   const auto j = nlohmann::json::parse(r.out);
@@ -89,17 +85,17 @@ TEST_CASE("geometry of a shared glyph and its drawing", "[cli][geometry]") {
   CHECK(drawing.find("control polygon") != std::string::npos);
   CHECK(drawing.find("</svg>") != std::string::npos);
   // same input, same output byte for byte
-  const std::string svg2 = tmp_dir() + "/eight2.svg";
+  const std::string svg2 = (dir.path() / "eight2.svg").string();
   const Run r2 = run(std::string("geometry '") + FEBEMESH_DATA_DIR + "/2d/DejaVuSans-U0038.svg' --svg '" + svg2 + "'");
   CHECK(r2.out == r.out);
   CHECK(slurp(svg2) == drawing);
 }
 
 TEST_CASE("geometry exit codes: bad input 1 with a message, bad usage 2", "[cli][geometry]") {
-  const std::string dir = tmp_dir();
+  const febemesh::test::ScratchDir scratch("geometry_cli");
+  const std::string dir = scratch.path().string();
   const std::string err = dir + "/err.txt";
   const std::string svg = dir + "/never.svg";
-  std::filesystem::remove(svg);
   const std::string bad = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/nan_path.svg";
   const Run r = run("geometry '" + bad + "' --svg '" + svg + "'", err);
   CHECK(r.status == 1);

@@ -13,10 +13,10 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include "core/read_msh.hpp"
 #include "core/validate.hpp"
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -44,17 +44,13 @@ std::string read_text(const std::filesystem::path& p) {
   return ss.str();
 }
 
-std::filesystem::path scratch(const std::string& name) {
-  return std::filesystem::temp_directory_path() / ("febemesh_mesh2d_cli_" + name + "_" + std::to_string(::getpid()));
-}
-
 const std::string flange = std::string(FEBEMESH_SOURCE_DIR) + "/examples/flange.json";
 
 }  // namespace
 
 TEST_CASE("mesh2d writes mesh.msh, mesh.vtu and a report whose counts are the mesh's", "[cli][mesh2d]") {
-  const auto dir = scratch("outputs");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "outputs";
   const Run r = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 6 --threads 1 --quiet");
   INFO(r.output);
   REQUIRE(r.status == 0);
@@ -75,14 +71,13 @@ TEST_CASE("mesh2d writes mesh.msh, mesh.vtu and a report whose counts are the me
     CHECK(t[step].get<double>() >= 0.0);
     CHECK(t[step].get<double>() <= t["total"].get<double>());
   }
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d's report counts the stages whether or not it kept them for the figures", "[cli][mesh2d]") {
   // Without figures the trees and the complex are dropped as soon as they are used (memory);
   // the report counted them from the dropped copies: 1 leaf, 0 boundary quadrants.
-  const auto dir = scratch("counts");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "counts";
   for (const char* figures : {"auto", "none"})
     REQUIRE(run("mesh2d '" + flange + "' -o '" + (dir / figures).string() + "' --level 6 --quiet --figures " + figures).status == 0);
   const auto kept = nlohmann::json::parse(read_text(dir / "auto" / "report.json"));
@@ -104,12 +99,11 @@ TEST_CASE("mesh2d's report counts the stages whether or not it kept them for the
   // One boundary quadrant a free edge of the interior quadrants.
   CHECK(c["boundary_quadrants"] == dropped["boundary_quadrants"]["free_edges"]);
   CHECK(c["boundary_quadrants"].get<std::size_t>() > 0);
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d's progress lines carry the seconds since the start, never decreasing", "[cli][mesh2d]") {
-  const auto dir = scratch("progress");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "progress";
   const Run r = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 6 --threads 1");
   INFO(r.output);
   REQUIRE(r.status == 0);
@@ -126,17 +120,16 @@ TEST_CASE("mesh2d's progress lines carry the seconds since the start, never decr
     ++n;
   }
   CHECK(n >= 5);  // reading, the stages, writing
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d gives the same mesh.msh on 1 and 2 threads", "[cli][mesh2d]") {
-  const auto dir = scratch("threads");
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "threads";
   for (const char* n : {"1", "2"})
     REQUIRE(run("mesh2d '" + flange + "' -o '" + (dir / n).string() + "' --level 7 --quiet --threads " + n).status == 0);
   const std::string one = read_text(dir / "1" / "mesh.msh"), two = read_text(dir / "2" / "mesh.msh");
   CHECK(one.size() > 10000);
   CHECK(one == two);
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart", "[cli][mesh2d]") {
@@ -144,7 +137,8 @@ TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart
   // glibc.malloc.hugetlb=1, unless GLIBC_TUNABLES sets the tunable already: the same arguments,
   // the same mesh. With FEBEMESH_HUGE_PAGES=0 no restart; one malloc arena and an 8 MiB mmap
   // threshold either way, unless GLIBC_TUNABLES sets them.
-  const auto dir = scratch("hugepages");
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "hugepages";
   const std::string args = "mesh2d '" + flange + "' --level 6 --quiet -o '";
   REQUIRE(run(args + (dir / "default").string() + "'").status == 0);
   REQUIRE(run(args + (dir / "huge").string() + "'", "FEBEMESH_HUGE_PAGES=1").status == 0);
@@ -178,12 +172,11 @@ TEST_CASE("mesh2d gives the same mesh.msh with and without the huge-page restart
     CHECK((WIFEXITED(st) && WEXITSTATUS(st) == 0));
     CHECK(a == read_text(dir / "loader" / "mesh.msh"));
   }
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d refuses bad input with exit 1, one message naming the file, and no folder", "[cli][mesh2d]") {
-  const auto dir = scratch("bad");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "bad";
   for (const std::string& input : {std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/malformed.json",
                                    std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/open_chain.poly",
                                    std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim2/bad_inputs/nan_path.svg",
@@ -198,8 +191,8 @@ TEST_CASE("mesh2d refuses bad input with exit 1, one message naming the file, an
 }
 
 TEST_CASE("mesh2d refuses bad usage with exit 2 and points to --help", "[cli][mesh2d]") {
-  const auto dir = scratch("usage");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "usage";
   const std::string in = "mesh2d '" + flange + "'";
   for (const std::string& args : {in, in + " -o '" + dir.string() + "' --bogus",
                                   in + " -o '" + dir.string() + "' --elements hex",
@@ -220,8 +213,8 @@ TEST_CASE("mesh2d refuses bad usage with exit 2 and points to --help", "[cli][me
 TEST_CASE("mesh2d and mesh3d refuse a tree over --max-cells: the file, the reason and the flag", "[cli][mesh2d][mesh3d]") {
   // Refused by the refinement itself (flange at level 14: ~1.9 x 10^8 quadrants; the CLI's own
   // estimate before it lets the level through), and in 3D by --max-cells.
-  const auto dir = scratch("max_cells");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "max_cells";
   const Run r2 = run("mesh2d '" + flange + "' -o '" + dir.string() + "' --level 14 --quiet");
   INFO(r2.output);
   CHECK(r2.status == 1);
@@ -245,8 +238,8 @@ TEST_CASE("mesh2d --size: the quadrants' side instead of a level; the count foll
   // The flange is 6 x 6 (the default root square 6.3 across): level 6's quadrant is 6.3 / 64.
   // Sizes between level 6's and level 7's give counts between theirs; level 6's own size gives
   // level 6's mesh.
-  const auto dir = scratch("size");
-  std::filesystem::remove_all(dir);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const auto dir = scratch.path() / "size";
   const auto mesh = [&](const std::string& name, const std::string& args) {
     const Run r = run("mesh2d '" + flange + "' -o '" + (dir / name).string() + "' --threads 1 --no-figures --quiet " + args);
     INFO(args << "\n" << r.output);
@@ -277,13 +270,12 @@ TEST_CASE("mesh2d --size: the quadrants' side instead of a level; the count foll
   CHECK(run("mesh2d '" + flange + "' -o '" + (dir / "x").string() + "' --size 0.1 --level 6").status == 2);
   CHECK(run("mesh2d '" + flange + "' -o '" + (dir / "x").string() + "' --size -1").status == 2);
   CHECK_FALSE(std::filesystem::exists(dir / "x"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh2d and mesh3d never replace a folder they did not write", "[cli][mesh2d][mesh3d]") {
   namespace fs = std::filesystem;
-  const auto root = scratch("foreign");
-  fs::remove_all(root);
+  const febemesh::test::ScratchDir scratch("mesh2d_cli");
+  const fs::path& root = scratch.path();
   const fs::path mine = root / "work";
   fs::create_directories(mine);
   std::ofstream(mine / "thesis.tex") << "years of work";
@@ -304,5 +296,4 @@ TEST_CASE("mesh2d and mesh3d never replace a folder they did not write", "[cli][
   CHECK(fs::exists(out / ".febemesh-output"));
   REQUIRE(run("mesh2d '" + flange + "' -o '" + out.string() + "' --level 6 --quiet --no-figures").status == 0);
   CHECK(fs::exists(out / "mesh.msh"));
-  fs::remove_all(root);
 }

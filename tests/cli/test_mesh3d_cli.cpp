@@ -9,10 +9,10 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include "core/read_msh.hpp"
 #include "core/write_msh.hpp"
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -31,18 +31,17 @@ std::string read_text(const std::filesystem::path& p) {
 
 /// sphere966 meshed at `level` on one thread twice, into dir/a with the default options and into
 /// dir/b with `b_options` (the ways the CLI's switches are compared); both runs must exit 0.
+/// dir is a scratch folder, removed with the pair (also when a run fails: scratch is a member).
 struct SpherePair {
+  febemesh::test::ScratchDir scratch;
   std::filesystem::path dir;
   SpherePair(const std::string& name, int level, const std::string& b_options)
-      : dir(std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_" + name + "_" + std::to_string(::getpid()))) {
+      : scratch("mesh3d_cli_" + name), dir(scratch.path()) {
     const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
     const std::string common = "mesh3d '" + sphere + "' --level " + std::to_string(level) + " --quiet --threads 1 -o '";
     REQUIRE(run_status(common + (dir / "a").string() + "'") == 0);
     REQUIRE(run_status(common + (dir / "b").string() + "' " + b_options) == 0);
   }
-  ~SpherePair() { std::filesystem::remove_all(dir); }
-  SpherePair(const SpherePair&) = delete;
-  SpherePair& operator=(const SpherePair&) = delete;
   std::filesystem::path msh(const char* run) const { return dir / run / "mesh.msh"; }
   nlohmann::json report(const char* run) const { return nlohmann::json::parse(read_text(dir / run / "report.json")); }
 };
@@ -60,7 +59,8 @@ void check_same_mesh_on_1_and_2_threads(const std::string& input, const std::fil
 }  // namespace
 
 TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_" + std::to_string(::getpid()));
+  const febemesh::test::ScratchDir scratch("mesh3d_cli");
+  const auto& dir = scratch.path();
   const std::string sphere = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
   check_same_mesh_on_1_and_2_threads(sphere, dir);
   CHECK(nlohmann::json::parse(read_text(dir / "2" / "report.json"))["options"]["threads"] == 2);
@@ -81,14 +81,14 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads", "[cli][mesh3d]") {
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --effort 0.5") == 2);
   CHECK(run_status("mesh3d '" + sphere + "' -o '" + (dir / "0").string() + "' --threads 0") == 2);
   CHECK(!std::filesystem::exists(dir / "0"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads with features and sliding surface nodes", "[cli][mesh3d]") {
   // Spool: feature snapping, surface nodes that slide in the tet optimiser (projected onto the
   // surface on both threads), 163k tets through the thickness retry; the smoothing and the
   // optimiser run on 2 threads.
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_spool_" + std::to_string(::getpid()));
+  const febemesh::test::ScratchDir scratch("mesh3d_cli_spool");
+  const auto& dir = scratch.path();
   check_same_mesh_on_1_and_2_threads(std::string(FEBEMESH_DATA_DIR) + "/3d/spool.off", dir);
   // Its mesh comes from the thickness retry: the first try's time is reported beside the kept
   // try's stages, and the total holds them all.
@@ -100,7 +100,6 @@ TEST_CASE("mesh3d gives the same mesh on 1 and 2 threads with features and slidi
     if (name != "total") parts += seconds.get<double>();
   CHECK(t["tries_not_kept"].get<double>() > 0.0);
   CHECK(t["total"].get<double>() >= parts);
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh3d --binary writes the same mesh as MSH 4.1 binary, and mesh.vtu as raw appended binary", "[cli][mesh3d]") {
@@ -279,8 +278,8 @@ TEST_CASE("mesh3d --flat-buffer (hidden, for experiments) and --flat-retry-below
 TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in its own", "[cli][mesh3d]") {
   // A box 1 x 0.6 x 0.3 turned by 30 degrees about z and 40 about x: every face at an angle to
   // the given axes (Options3d::align_planar_faces, dim3/planar_frame.hpp).
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_frame_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const febemesh::test::ScratchDir scratch("mesh3d_cli_frame");
+  const auto& dir = scratch.path();
   const double cz = std::cos(30 * M_PI / 180), sz = std::sin(30 * M_PI / 180);
   const double cx = std::cos(40 * M_PI / 180), sx = std::sin(40 * M_PI / 180);
   {
@@ -318,7 +317,6 @@ TEST_CASE("mesh3d meshes a turned box in the frame of its faces; --given-axes in
   // In the frame the box's faces lie on lattice planes: a smaller volume error than in its axes.
   CHECK(a["fidelity"]["volume_rel_error"].get<double>() < b["fidelity"]["volume_rel_error"].get<double>());
   CHECK(a["validation"]["valid"] == true);
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("mesh3d --size: the octants' side instead of a level; with --level, or past level 9, bad usage",
@@ -352,7 +350,8 @@ TEST_CASE("mesh3d --size: the octants' side instead of a level; with --level, or
 TEST_CASE("mesh3d's warning for lost volume says how thin the parts are against the octants", "[cli][mesh3d]") {
   // rotor.off at level 3 (the root cube 1.05 across, octants 0.13125) loses a third of its
   // volume: its blades and wall are 0.006-0.02 thick.
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_mesh3d_cli_thin_" + std::to_string(::getpid()));
+  const febemesh::test::ScratchDir scratch("mesh3d_cli_thin");
+  const auto dir = scratch.path() / "rotor";
   const std::string rotor = std::string(FEBEMESH_DATA_DIR) + "/3d/rotor.off";
   REQUIRE(run_status("mesh3d '" + rotor + "' --level 3 --quiet -o '" + dir.string() + "'") == 0);
   const auto j = nlohmann::json::parse(read_text(dir / "report.json"));
@@ -371,5 +370,4 @@ TEST_CASE("mesh3d's warning for lost volume says how thin the parts are against 
   CHECK(growth > 170);
   CHECK(w.find("x this mesh's " + std::to_string(j["counts"]["interface_triangles"].get<long>()) + " interface faces") !=
         std::string::npos);
-  std::filesystem::remove_all(dir);
 }

@@ -4,28 +4,23 @@
 
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 #include "core/atomic_output.hpp"
 #include "core/error.hpp"
+#include "scratch_dir.hpp"
 
 using namespace febemesh;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path scratch() {
-  const fs::path dir = fs::temp_directory_path() / ("febemesh_atomic_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 std::size_t n_entries(const fs::path& dir) {
   return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 }  // namespace
 
 TEST_CASE("an uncommitted output folder leaves nothing", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   const fs::path out = root / "out";
   {
     AtomicOutputDir dir(out);
@@ -44,11 +39,11 @@ TEST_CASE("an uncommitted output folder leaves nothing", "[atomic_output]") {
   } catch (const std::runtime_error&) {
   }
   CHECK(n_entries(root) == 0);
-  fs::remove_all(root);
 }
 
 TEST_CASE("commit moves the folder into place and replaces a previous run", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   const fs::path out = root / "nested" / "out";
   {
     AtomicOutputDir dir(out);
@@ -67,22 +62,22 @@ TEST_CASE("commit moves the folder into place and replaces a previous run", "[at
   CHECK(fs::exists(out / "new.txt"));
   CHECK_FALSE(fs::exists(out / "old.txt"));
   CHECK(n_entries(out.parent_path()) == 1);  // no temporary or old folder left
-  fs::remove_all(root);
 }
 
 TEST_CASE("a trailing separator names the same folder", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   {
     AtomicOutputDir dir(root.string() + "/out/");
     dir.commit();
   }
   CHECK(fs::is_directory(root / "out"));
   CHECK(n_entries(root) == 1);
-  fs::remove_all(root);
 }
 
 TEST_CASE("a folder febemesh did not write is never replaced", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   const fs::path out = root / "work";
   fs::create_directories(out / "thesis");
   std::ofstream(out / "notes.txt") << "mine";
@@ -103,11 +98,11 @@ TEST_CASE("a folder febemesh did not write is never replaced", "[atomic_output]"
   std::ofstream(root / "file") << "x";
   CHECK_THROWS_AS(AtomicOutputDir(root / "file"), InputError);
   CHECK(fs::is_regular_file(root / "file"));
-  fs::remove_all(root);
 }
 
 TEST_CASE("a folder that becomes foreign during the run is kept at commit", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   const fs::path out = root / "out";
   {
     AtomicOutputDir dir(out);
@@ -127,11 +122,11 @@ TEST_CASE("a folder that becomes foreign during the run is kept at commit", "[at
   }
   CHECK(fs::exists(out / "data.csv"));
   CHECK(n_entries(root) == 1);  // the temporary folder removed
-  fs::remove_all(root);
 }
 
 TEST_CASE("an output folder of an earlier version, without the marker, is replaced", "[atomic_output]") {
-  const fs::path root = scratch();
+  const test::ScratchDir scratch("atomic");
+  const fs::path& root = scratch.path();
   const fs::path out = root / "out";
   fs::create_directories(out / "figures");
   for (const char* name : {"mesh.msh", "mesh.vtu", "report.json"}) std::ofstream(out / name) << "old";
@@ -150,5 +145,4 @@ TEST_CASE("an output folder of an earlier version, without the marker, is replac
     dir.commit();
   }
   CHECK(fs::exists(empty / std::string(kOutputMarker)));
-  fs::remove_all(root);
 }

@@ -9,12 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 #include "core/error.hpp"
 #include "core/read_msh.hpp"
 #include "core/validate.hpp"
 #include "core/write_msh.hpp"
+#include "scratch_dir.hpp"
 #include "test_mesh_fixtures.hpp"
 
 using namespace febemesh;
@@ -39,12 +39,6 @@ std::string slurp(const fs::path& p) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-fs::path temp_dir() {
-  const fs::path dir = fs::temp_directory_path() / ("febemesh_msh_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
 }
 
 /// A tiny 2D mesh: the unit square as two triangles, irrational coordinates on one node.
@@ -104,11 +98,11 @@ TEST_CASE("MSH golden file of a tiny 2D mesh", "[msh]") {
 
 TEMPLATE_TEST_CASE_SIG("write_msh writes the same bytes as msh_string", "[msh]", ((int Dim), Dim), 2, 3) {
   const Mesh<Dim> mesh = test::grid_mesh<Dim>(4, true);
-  const fs::path file = temp_dir() / ("grid" + std::to_string(Dim) + ".msh");
+  const test::ScratchDir dir("msh_test");
+  const fs::path file = dir.path() / ("grid" + std::to_string(Dim) + ".msh");
   write_msh(mesh, file);
   CHECK(slurp(file) == msh_string(mesh));
   check_same(mesh, read_msh<Dim>(file));
-  fs::remove(file);
   CHECK_THROWS_AS(write_msh(mesh, fs::path("/nonexistent-dir/x.msh")), InputError);
 }
 
@@ -133,13 +127,13 @@ TEST_CASE("write_msh on several threads writes the bytes of one", "[msh]") {
   test::set_interface_to_boundary(mesh);
   REQUIRE(mesh.solid.size() > 3 * 16384);
   const std::string one = msh_string(mesh);
-  const fs::path file = temp_dir() / "threads.msh";
+  const test::ScratchDir dir("msh_test");
+  const fs::path file = dir.path() / "threads.msh";
   for (const int threads : {1, 2, 3, 8}) {
     write_msh(mesh, file, MshEncoding::Ascii, threads);
     CHECK(slurp(file) == one);
   }
   check_same(mesh, read_msh<2>(file));
-  fs::remove(file);
   // A failing write stops every thread and throws (no hang, no crash).
   if (fs::exists("/dev/full")) CHECK_THROWS_AS(write_msh(mesh, fs::path("/dev/full"), MshEncoding::Ascii, 2), InputError);
 }
@@ -183,7 +177,8 @@ TEMPLATE_TEST_CASE_SIG("gmsh reads our MSH file and writes back the same mesh", 
     return;
   }
   const Mesh<Dim> mesh = test::grid_mesh<Dim>(2, true, 0.5);
-  const fs::path dir = temp_dir();
+  const test::ScratchDir scratch("msh_test");
+  const fs::path& dir = scratch.path();
   const fs::path in = dir / ("in" + std::to_string(Dim) + ".msh"), out = dir / ("out" + std::to_string(Dim) + ".msh");
   const fs::path log = dir / "gmsh.log";
   write_msh(mesh, in);
@@ -197,7 +192,6 @@ TEMPLATE_TEST_CASE_SIG("gmsh reads our MSH file and writes back the same mesh", 
   CHECK(back.solid.size() == mesh.solid.size());
   CHECK(back.interface.size() == mesh.interface.size());
   CHECK(is_valid(back));
-  fs::remove_all(dir);
 }
 
 TEST_CASE("MSH writer throughput", "[msh][benchmark]") {
@@ -232,11 +226,11 @@ TEST_CASE("binary MSH of mixed element types and the writer's file", "[msh]") {
   m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{2}, VertexId{1}, VertexId{5}});
   m.solid.add(ElemType::Tet4, {VertexId{0}, VertexId{3}, VertexId{2}, VertexId{5}});
   test::set_interface_to_boundary(m);
-  const fs::path file = temp_dir() / "mixed-binary.msh";
+  const test::ScratchDir dir("msh_test");
+  const fs::path file = dir.path() / "mixed-binary.msh";
   write_msh(m, file, MshEncoding::Binary);
   CHECK(slurp(file) == msh_string(m, MshEncoding::Binary));
   check_same(m, read_msh<3>(file));
-  fs::remove(file);
 }
 
 TEST_CASE("binary MSH reader rejects truncated data with a message", "[msh]") {
@@ -258,7 +252,8 @@ TEMPLATE_TEST_CASE_SIG("gmsh reads our binary MSH file and writes binary we read
     return;
   }
   const Mesh<Dim> mesh = test::grid_mesh<Dim>(2, true, 0.5);
-  const fs::path dir = temp_dir();
+  const test::ScratchDir scratch("msh_test");
+  const fs::path& dir = scratch.path();
   const fs::path in = dir / ("bin-in" + std::to_string(Dim) + ".msh"), out = dir / ("bin-out" + std::to_string(Dim) + ".msh");
   const fs::path log = dir / "gmsh-bin.log";
   write_msh(mesh, in, MshEncoding::Binary);
@@ -274,5 +269,4 @@ TEMPLATE_TEST_CASE_SIG("gmsh reads our binary MSH file and writes binary we read
   CHECK(back.solid.size() == mesh.solid.size());
   CHECK(back.interface.size() == mesh.interface.size());
   CHECK(is_valid(back));
-  fs::remove_all(dir);
 }

@@ -11,6 +11,7 @@
 
 #include "core/validate.hpp"
 #include "dim3/compare_tetgen.hpp"
+#include "scratch_dir.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -47,8 +48,8 @@ TEST_CASE("a failing TetGen is contained in a child process and reported", "[tet
   TriangleSoup soup;
   add_tetrahedron(soup, P3(0, 0, 0), 1.0);
   add_tetrahedron(soup, P3(0.2, 0.2, 0.2), 1.0);
-  const std::string log = (std::filesystem::temp_directory_path() /
-                           ("febemesh_tetgen_" + std::to_string(::getpid()) + ".log")).string();
+  const test::ScratchDir scratch("tetgen");
+  const std::string log = (scratch.path() / "tetgen.log").string();
   const ChildResult r = run_in_child([&] { tetgen_mesh(soup, "p", log); });
   INFO(r.error);
   CHECK(!r.ok);
@@ -64,5 +65,4 @@ TEST_CASE("a failing TetGen is contained in a child process and reported", "[tet
   printed << in.rdbuf();
   INFO("TetGen printed: " << printed.str());
   CHECK(!printed.str().empty());
-  std::filesystem::remove(log);
 }

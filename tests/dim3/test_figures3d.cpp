@@ -15,6 +15,7 @@
 #include "dim3/figures3d.hpp"
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_checks.hpp"
+#include "scratch_dir.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -194,8 +195,8 @@ TEST_CASE("section_segments: the cut of the surface, one segment a crossed trian
 TEST_CASE("write_mesh_figures writes the sections and the BE view, and says what it left out", "[figures3d]") {
   const Result3d r = mesh_box(false);
   const Surface s(box_soup());
-  const auto dir = std::filesystem::temp_directory_path() / ("febemesh_figures3d_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
+  const test::ScratchDir scratch("figures3d");
+  const auto dir = scratch.path() / "figures";
   const MeshFigures all = write_mesh_figures(r.fe.mesh, s, dir, 0);
   CHECK(all.written.size() == 4);
   CHECK(all.skipped.empty());
@@ -218,5 +219,4 @@ TEST_CASE("write_mesh_figures writes the sections and the BE view, and says what
   text << note.rdbuf();
   CHECK(text.str().find("over the limit of 5") != std::string::npos);
   CHECK(!std::filesystem::exists(dir / "section-x.svg"));
-  std::filesystem::remove_all(dir);
 }

@@ -25,6 +25,7 @@
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_checks.hpp"
 #include "property.hpp"
+#include "scratch_dir.hpp"
 #include "surface_generators.hpp"
 
 using namespace febemesh;
@@ -273,8 +274,8 @@ TEST_CASE("hex-dominant: a hex mesh losing more volume than its tets takes its o
 }
 
 TEST_CASE("mesh3d --elements hex writes a valid mesh.msh with hexes", "[hex_dominant][cli]") {
-  const std::filesystem::path out = std::filesystem::temp_directory_path() / "febemesh_test_hex_dominant";
-  std::filesystem::remove_all(out);
+  const test::ScratchDir scratch("test_hex_dominant");
+  const std::filesystem::path out = scratch.path() / "out";
   const std::string input = std::string(FEBEMESH_DATA_DIR) + "/3d/sphere966.off";
   const std::string cmd =
       std::string(FEBEMESH_CLI) + " mesh3d " + input + " --level 3 --elements hex --quiet -o " + out.string();
@@ -295,7 +296,6 @@ TEST_CASE("mesh3d --elements hex writes a valid mesh.msh with hexes", "[hex_domi
   CHECK(rep["hex_dominant"]["hexahedra"].get<std::size_t>() == c.hex);
   CHECK(rep["hex_dominant"]["hex_share"].get<double>() > 0.0);
   CHECK(rep["validation"]["valid"].get<bool>());
-  std::filesystem::remove_all(out);
 }
 
 // What the hex-dominant mesh relies on the validator for: a quad face against a pyramid's base

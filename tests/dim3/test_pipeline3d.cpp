@@ -21,6 +21,7 @@
 #include "dim3/pipeline3d.hpp"
 #include "dim3/surface_checks.hpp"
 #include "dim3/tet_optimize.hpp"
+#include "scratch_dir.hpp"
 #include "thrown.hpp"
 
 using namespace febemesh;
@@ -99,15 +100,14 @@ TEST_CASE("sphere966 at level 4 gives a valid mesh close to the sphere's volume"
 }
 
 TEST_CASE("mesh3d refuses an open surface with exit 1 and writes nothing", "[pipeline3d][cli]") {
-  const std::filesystem::path out = std::filesystem::temp_directory_path() / "febemesh_test_open_cylinder";
-  std::filesystem::remove_all(out);
+  const test::ScratchDir scratch("test_open_cylinder");
+  const std::filesystem::path out = scratch.path() / "out";
   const std::string cmd = std::string(FEBEMESH_CLI) + " mesh3d " + FEBEMESH_DATA_DIR + "/3d/open-cylinder.off -o " +
                           out.string() + " --quiet 2> " + out.string() + ".err";
   const int status = std::system(cmd.c_str());
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 1);
   CHECK_FALSE(std::filesystem::exists(out));
-  std::filesystem::remove(out.string() + ".err");
 }
 
 // A torus whose tube (0.7 across) is 1.1 octants thick at --size 1.745 level-3 octants

@@ -20,6 +20,7 @@
 #include "dim3/surface.hpp"
 #include "dim3/surface_boundary.hpp"
 #include "dim3/surface_checks.hpp"
+#include "scratch_dir.hpp"
 
 using namespace febemesh;
 using namespace febemesh::dim3;
@@ -61,24 +62,19 @@ std::string refusal(const std::string& path) {
   return "";
 }
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "febemesh_test_read_surface";
-  fs::create_directories(dir);
-  return dir / name;
-}
-
 // The unit cube, outward, as 8 vertices and 12 triangles.
 const double cube_v[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
 const int cube_f[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
                            {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
 
-/// The cube as OBJ, ASCII PLY (coordinates of `ply_type`), ASCII STL and binary STL: scratch
-/// files STEM.obj, STEM.ply, STEM-ascii.stl and STEM-binary.stl, corner k of face f being
+/// The cube as OBJ, ASCII PLY (coordinates of `ply_type`), ASCII STL and binary STL: files
+/// STEM.obj, STEM.ply, STEM-ascii.stl and STEM-binary.stl in `dir`, corner k of face f being
 /// vertex corner(f, k).
 template <class Corner>
-std::array<fs::path, 4> write_cube(const std::string& stem, const std::string& ply_type, const Corner& corner) {
-  const fs::path obj = scratch(stem + ".obj"), ply = scratch(stem + ".ply"), ascii = scratch(stem + "-ascii.stl"),
-                 binary = scratch(stem + "-binary.stl");
+std::array<fs::path, 4> write_cube(const fs::path& dir, const std::string& stem, const std::string& ply_type,
+                                   const Corner& corner) {
+  const fs::path obj = dir / (stem + ".obj"), ply = dir / (stem + ".ply"), ascii = dir / (stem + "-ascii.stl"),
+                 binary = dir / (stem + "-binary.stl");
   std::ofstream o(obj), p(ply), a(ascii), b(binary, std::ios::binary);
   p << "ply\nformat ascii 1.0\nelement vertex 8\nproperty " << ply_type << " x\nproperty " << ply_type << " y\nproperty "
     << ply_type << " z\nelement face 12\nproperty list uchar int vertex_indices\nend_header\n";
@@ -152,7 +148,8 @@ TEST_CASE("an inverted sphere is accepted and turned outward", "[read_surface]")
   Surface original(read_surface(data3d + "sphere966.off"));
   validate_surface(original, "sphere966.off");
   const double v0 = original.volume();
-  const fs::path flipped = scratch("flipped-sphere.off");
+  const test::ScratchDir dir("read_surface");
+  const fs::path flipped = dir.path() / "flipped-sphere.off";
   {
     std::ofstream out(flipped);
     out << "OFF\n" << original.n_vertices() << " " << original.n_triangles() << " 0\n";
@@ -233,9 +230,10 @@ TEST_CASE("bad inputs are refused with the file name and the reason", "[read_sur
 }
 
 TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_surface]") {
-  const auto [obj, ply, ascii, binary] = write_cube("cube", "float", [](int f, int k) { return cube_f[f][k]; });
+  const test::ScratchDir dir("read_surface");
+  const auto [obj, ply, ascii, binary] = write_cube(dir.path(), "cube", "float", [](int f, int k) { return cube_f[f][k]; });
   // A binary STL whose header begins with "solid", as some exporters write it.
-  const fs::path solid_binary = scratch("cube-binary-solid.stl");
+  const fs::path solid_binary = dir.path() / "cube-binary-solid.stl";
   {
     std::ifstream in(binary, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -253,7 +251,7 @@ TEST_CASE("STL (ASCII and binary), OBJ and PLY read through OpenMesh", "[read_su
   }
   // Cut short, or too short for a header: said so (OpenMesh read both as empty, and the
   // message was "empty surface (no faces)").
-  const fs::path cut = scratch("cube-binary-cut.stl"), stub = scratch("stub.stl");
+  const fs::path cut = dir.path() / "cube-binary-cut.stl", stub = dir.path() / "stub.stl";
   {
     std::ifstream in(binary, std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -282,7 +280,8 @@ TEST_CASE("STL, OBJ and PLY whose triangles are wound inconsistently are read wh
     const bool flip = f % 3 == 1;
     return flip && k > 0 ? cube_f[f][3 - k] : cube_f[f][k];
   };
-  const auto [obj, ply, ascii, binary] = write_cube("wound", "double", corner);
+  const test::ScratchDir dir("read_surface");
+  const auto [obj, ply, ascii, binary] = write_cube(dir.path(), "wound", "double", corner);
   for (const fs::path& path : {obj, ply, ascii, binary}) {
     INFO(path);
     Surface s(read_surface(path.string()));
@@ -317,7 +316,8 @@ TEST_CASE("OBJ and PLY are read in double precision and their faults named with 
              std::to_string(cube_f[f][2] + 1) + "\n";
     return out;
   };
-  const fs::path obj = scratch("faulty.obj"), ply = scratch("faulty.ply");
+  const test::ScratchDir dir("read_surface");
+  const fs::path obj = dir.path() / "faulty.obj", ply = dir.path() / "faulty.ply";
   // Lines 1-8 are the vertices, 9-20 the faces.
   CHECK_THAT(refusal(obj, obj_cube + obj_faces(5, "6")), Catch::StartsWith(obj.string() + ":14: face 5: vertex 6 appears twice"));
   CHECK_THAT(refusal(obj, obj_cube + obj_faces(2, "0")), Catch::Contains(":11: face 2: vertex index 0 (OBJ counts vertices from 1)"));

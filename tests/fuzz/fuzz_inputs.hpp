@@ -10,8 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include <unistd.h>
-
+#include "../scratch_dir.hpp"
 #include "core/error.hpp"
 #include "dim2/curve_boundary.hpp"
 #include "dim2/read_native.hpp"
@@ -58,10 +57,11 @@ inline void off_input(std::string_view data) {
 }
 
 /// The bytes as an .stl file read through OpenMesh (read_with_openmesh, as read_surface does
-/// for .stl), then indexed as a Surface. The file is per process, so parallel jobs do not clash.
+/// for .stl), then indexed as a Surface. The file is in a scratch folder of its own (per process
+/// and input), removed on the way out also when an exception other than InputError escapes.
 inline void stl_input(std::string_view data) {
-  const std::filesystem::path path =
-      std::filesystem::temp_directory_path() / ("febemesh_fuzz_" + std::to_string(::getpid()) + ".stl");
+  const test::ScratchDir dir("fuzz");
+  const std::filesystem::path path = dir.path() / "input.stl";
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(data.data(), static_cast<std::streamsize>(data.size()));
@@ -70,7 +70,6 @@ inline void stl_input(std::string_view data) {
     (void)dim3::Surface(dim3::read_with_openmesh(path.string()));
   } catch (const InputError&) {
   }
-  std::filesystem::remove(path);
 }
 
 /// The bytes as OBJ or PLY (read_obj, read_ply), then indexed as a Surface.
