@@ -41,16 +41,27 @@ Result3d with_fallback(const Run& run, const Options3d& opt, const Options3d& fa
   }
 }
 
+/// What feature snapping does on this surface with these options: nothing (off, or no feature
+/// lines), nothing because the surface is faceted (more of its feature lines' ends free than
+/// Options3d::faceted_free_ends), or snap.
+enum class Snapping { Off, Faceted, Snapped };
+
+Snapping snapping(const SurfaceBoundary& s, const Options3d& opt) {
+  if (!opt.snap_features || s.features().n_feature_edges() == 0) return Snapping::Off;
+  return s.features().free_end_share() > opt.faceted_free_ends ? Snapping::Faceted : Snapping::Snapped;
+}
+
 Result3d mesh3d_features(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   const auto once = [&](const Options3d& o) { return mesh3d_once(s, o, effort, progress); };
-  if (!opt.snap_features || s.features().n_feature_edges() == 0) return once(opt);
+  const Snapping how = snapping(s, opt);
+  if (how == Snapping::Off) return once(opt);
   // Feature snapping pulls nodes across octants; on coarsely faceted surfaces (every edge a
   // feature: tori of 8 segments) it leaves tetrahedra no node move can unfold, where the plain
   // projection meshes validly.
   Options3d plain = opt;
   plain.snap_features = false;
-  const double free_ends = s.features().free_end_share();
-  if (free_ends > opt.faceted_free_ends) {
+  if (how == Snapping::Faceted) {
+    const double free_ends = s.features().free_end_share();
     if (progress)
       progress("without feature snapping: " + std::to_string(static_cast<int>(std::lround(100.0 * free_ends))) +
                "% of the feature lines' ends are free (a faceted surface)");
@@ -136,9 +147,7 @@ Result3d mesh3d_facing(SurfaceBoundary& s, const Options3d& opt, Effort& effort,
 /// are refused every try without it, in the same order.
 Result3d mesh3d_tries(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const Progress3& progress) {
   const auto facing = [&](const Options3d& o) { return mesh3d_facing(s, o, effort, progress); };
-  const bool snaps = opt.snap_features && s.features().n_feature_edges() > 0 &&
-                     !(s.features().free_end_share() > opt.faceted_free_ends);
-  if (!opt.features_fallback_last || !snaps) return facing(opt);
+  if (!opt.features_fallback_last || snapping(s, opt) != Snapping::Snapped) return facing(opt);
   Options3d plain = opt;
   plain.snap_features = false;
   return with_fallback(facing, opt, plain, "without feature snapping, every try", &Result3d::features_dropped, progress,
@@ -384,9 +393,7 @@ Result3d uniform_after_refusal(SurfaceBoundary& s, const Options3d& opt, Effort&
 /// refused.
 std::optional<Result3d> uniform_early(SurfaceBoundary& s, const Options3d& opt, Effort& effort, const GeometryError& e,
                                       bool snapped, const Progress3& progress) {
-  const Features& f = s.features();
-  const bool faceted = opt.snap_features && f.n_feature_edges() > 0 && f.free_end_share() > opt.faceted_free_ends;
-  const bool applies = snapped ? opt.uniform_early_snapped : opt.uniform_early_faceted && faceted;
+  const bool applies = snapped ? opt.uniform_early_snapped : opt.uniform_early_faceted && snapping(s, opt) == Snapping::Faceted;
   if (!applies || !opt.uniform_after_refusal || opt.extra_levels <= 0 || effort.uniform_tried) return std::nullopt;
   if (progress)
     progress(std::string("refused (") + e.what() + "): " +
