@@ -24,6 +24,7 @@
 
 #include "core/error.hpp"
 #include "core/orthtree.hpp"
+#include "core/worker_pool.hpp"
 
 namespace febemesh {
 namespace {
@@ -84,30 +85,6 @@ template <int Dim> [[noreturn]] void refuse_balance(std::size_t n_leaves, std::s
      << " MiB at " << sizeof(Cell<Dim>) << " bytes per leaf), more than max_leaves = " << max_leaves
      << "; raise the limit or refine less";
   throw LimitError(os.str());
-}
-
-/// Runs f(t) on threads t = 0..n_threads-1 (t = 0 on the caller), waits for all, and rethrows
-/// the first exception of the lowest thread.
-template <class F> void on_threads(int n_threads, const F& f) {
-  if (n_threads <= 1) {
-    f(0);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_threads));
-  const auto guarded = [&](int t) {
-    try {
-      f(t);
-    } catch (...) {
-      errors[std::size_t(t)] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < n_threads; ++t) threads.emplace_back(guarded, t);
-  guarded(0);
-  for (auto& th : threads) th.join();
-  for (const auto& e : errors) {
-    if (e) std::rethrow_exception(e);
-  }
 }
 
 /// For each set of internal children of a parent (bit k = child k), the directions in which the
@@ -211,7 +188,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   const int n_parts = leaves.size() < 65536 ? 1 : n_threads;
   std::vector<std::vector<std::vector<std::uint64_t>>> parts(
       static_cast<std::size_t>(n_parts), std::vector<std::vector<std::uint64_t>>(static_cast<std::size_t>(deepest)));
-  on_threads(n_parts, [&](int t) {
+  run_on_threads(n_parts, [&](int t) {
     auto& mine = parts[std::size_t(t)];
     const std::size_t begin = leaves.size() * std::size_t(t) / std::size_t(n_parts);
     const std::size_t end = leaves.size() * std::size_t(t + 1) / std::size_t(n_parts);
@@ -270,7 +247,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
         while (c > 0 && c < here.size() && (here[c] & parent_mask) == (here[c - 1] & parent_mask)) ++c;
         cut[std::size_t(t)] = c;
       }
-      on_threads(n_pieces, [&](int t) {
+      run_on_threads(n_pieces, [&](int t) {
         auto& mine = candidates[std::size_t(t)].v;
         mine.clear();
         append_candidates<Dim>(here, cut[std::size_t(t)], cut[std::size_t(t) + 1], level, table, mine);
@@ -305,7 +282,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
       const int child_shift = Dim * (max_level<Dim> - level - 1);
       // Pieces of `next` cut at sibling groups, so that no two threads write the same byte.
       const int n_pieces = next.size() < 4096 ? 1 : n_threads;
-      on_threads(n_pieces, [&](int t) {
+      run_on_threads(n_pieces, [&](int t) {
         std::size_t i = next.size() * std::size_t(t) / std::size_t(n_pieces);
         std::size_t end = next.size() * std::size_t(t + 1) / std::size_t(n_pieces);
         const auto group_start = [&](std::size_t c) {
@@ -399,7 +376,7 @@ Orthtree<Dim> balance_2to1(const Orthtree<Dim>& t, BalanceKind kind, const Balan
   Cell<Dim>* const cells = out.data();
   const std::size_t n_chunks = n_threads == 1 ? 1 : std::min(items.size(), std::size_t(n_threads) * 16);
   std::atomic<std::size_t> next{0};
-  on_threads(n_threads, [&](int) {
+  run_on_threads(n_threads, [&](int) {
     Walker<Dim> w{masks, std::vector<std::size_t>(static_cast<std::size_t>(deepest) + 1, 0), nullptr};
     for (std::size_t c; (c = next.fetch_add(1)) < n_chunks;) {
       for (std::size_t i = items.size() * c / n_chunks, e = items.size() * (c + 1) / n_chunks; i < e; ++i) {

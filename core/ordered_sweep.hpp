@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "core/parallel_ranges.hpp"
+#include "core/worker_pool.hpp"
 
 namespace febemesh {
 
@@ -313,10 +314,7 @@ void visit_dag(const SweepDag& dag, int n_threads, const Visit& visit, SweepReco
       lock.lock();
     }
   };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < n_threads; ++t) threads.emplace_back(run, t);
-  run(0);
-  for (auto& th : threads) th.join();
+  run_on_threads(n_threads, run);
   if (rec) {
     for (const double w : waited) rec->wait_s += w;
     for (const double c : cpu) rec->cpu_s += c;

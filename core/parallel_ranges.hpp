@@ -10,39 +10,25 @@
 #include <cstddef>
 #include <exception>
 #include <limits>
-#include <thread>
 #include <vector>
+
+#include "core/worker_pool.hpp"
 
 namespace febemesh {
 
 /// Calls f(begin, end) on n_threads contiguous ranges covering [0, n) (one range when n is small
-/// or n_threads is 1), the first on the calling thread; rethrows the first range's exception
-/// once all have stopped.
+/// or n_threads is 1), the first on the calling thread (the others on run_on_threads' threads);
+/// rethrows the first range's exception once all have stopped.
 template <class F> void for_each_range(std::size_t n, int n_threads, const F& f) {
   const std::size_t n_workers = std::size_t(std::clamp(n_threads, 1, 256));
   if (n_workers == 1 || n < 2 * n_workers) {
     f(std::size_t{0}, n);
     return;
   }
-  std::vector<std::exception_ptr> errors(n_workers);
-  std::vector<std::thread> threads;
-  for (std::size_t w = 1; w < n_workers; ++w) {
-    threads.emplace_back([&, w] {
-      try {
-        f(n * w / n_workers, n * (w + 1) / n_workers);
-      } catch (...) {
-        errors[w] = std::current_exception();
-      }
-    });
-  }
-  try {
-    f(std::size_t{0}, n / n_workers);
-  } catch (...) {
-    errors[0] = std::current_exception();
-  }
-  for (auto& th : threads) th.join();
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
+  run_on_threads(static_cast<int>(n_workers), [&](int t) {
+    const auto w = static_cast<std::size_t>(t);
+    f(n * w / n_workers, n * (w + 1) / n_workers);
+  });
 }
 
 /// The chunks [c * chunk, min(n, (c + 1) * chunk)) of [0, n): f(c, begin, end) for every chunk c,

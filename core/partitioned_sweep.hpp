@@ -25,12 +25,12 @@
 #include <cstdint>
 #include <exception>
 #include <span>
-#include <thread>
 #include <vector>
 
 #include "core/mesh.hpp"
 #include "core/ordered_sweep.hpp"  // mark()
 #include "core/parallel_ranges.hpp"
+#include "core/worker_pool.hpp"
 
 namespace febemesh {
 
@@ -146,21 +146,14 @@ class PartitionedSweep {
       visit_groups(0, n_groups, 0);
     } else {
       std::atomic<std::size_t> next{0};
-      std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n_workers));
-      const auto work = [&](int t) {
+      run_on_threads(n_workers, [&](int t) {
         try {
           for (std::size_t g; (g = next.fetch_add(1, std::memory_order_relaxed)) < n_groups;) visit_groups(g, g + 1, t);
         } catch (...) {
-          errors[static_cast<std::size_t>(t)] = std::current_exception();
           next.store(n_groups, std::memory_order_relaxed);  // the others stop after their part
+          throw;
         }
-      };
-      std::vector<std::thread> threads;
-      for (int t = 1; t < n_workers; ++t) threads.emplace_back(work, t);
-      work(0);
-      for (std::thread& th : threads) th.join();
-      for (const std::exception_ptr& e : errors)
-        if (e) std::rethrow_exception(e);
+      });
     }
     between();
     visit_groups(n_groups, n_groups + 1, 0);

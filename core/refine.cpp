@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "core/orthtree.hpp"
+#include "core/worker_pool.hpp"
 
 namespace febemesh {
 namespace {
@@ -225,13 +226,6 @@ template <int Dim> struct PredicateRule {
   }
 };
 
-/// Runs f(t) on threads t = 0..n_threads-1 (t = 0 on the caller) and waits for all.
-template <class F> void on_threads(int n_threads, const F& f) {
-  std::vector<std::thread> threads;
-  for (int t = 1; t < n_threads; ++t) threads.emplace_back(f, t);
-  f(0);
-  for (auto& th : threads) th.join();
-}
 
 /// Runs work(k, emitter) for k = 0..n_work-1 in order on n_threads threads and returns the
 /// leaves in that order. The result does not depend on the thread count: the work is cut into
@@ -257,7 +251,7 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
   std::vector<Range> ranges(n_chunks);
   std::vector<std::exception_ptr> errors(n_chunks);
   std::atomic<std::size_t> next{0};
-  on_threads(n_threads, [&](int t) {
+  run_on_threads(n_threads, [&](int t) {
     LevelSpool& out = spools[std::size_t(t)];
     for (;;) {
       const std::size_t k = next.fetch_add(1);
@@ -303,7 +297,7 @@ LeafVector<Dim> expand_in_order(std::size_t n_work, const Work& work, Budget& bu
   // the counts put it, whichever spool holds it: a thread slowed by another process then does
   // less, where fixed equal shares would make the other thread wait for it.
   next = 0;
-  on_threads(n_threads, [&](int) {
+  run_on_threads(n_threads, [&](int) {
     for (std::size_t k; (k = next.fetch_add(1)) < n_chunks;) {
       const Range& r = ranges[k];
       Cell<Dim>* dst = cells + offset[k];

@@ -22,6 +22,7 @@
 
 #include "core/error.hpp"
 #include "core/parallel_ranges.hpp"
+#include "core/worker_pool.hpp"
 #include "core/spill_buffer.hpp"
 
 namespace febemesh {
@@ -201,10 +202,7 @@ template <class Format> void parallel_lines(Sink& out, std::size_t count, int n_
       cv.notify_all();
     }
   };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < n_workers; ++t) threads.emplace_back(work);
-  work();
-  for (std::thread& th : threads) th.join();
+  run_on_threads(n_workers, [&](int) { work(); });
   if (error) std::rethrow_exception(error);
 }
 
