@@ -18,9 +18,7 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <exception>
 #include <sstream>
-#include <thread>
 
 #include "core/error.hpp"
 #include "core/orthtree.hpp"

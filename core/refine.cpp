@@ -12,7 +12,6 @@
 #include <memory>
 #include <new>
 #include <sstream>
-#include <thread>
 
 #include <sys/mman.h>
 
@@ -225,7 +224,6 @@ template <int Dim> struct PredicateRule {
     }
   }
 };
-
 
 /// Runs work(k, emitter) for k = 0..n_work-1 in order on n_threads threads and returns the
 /// leaves in that order. The result does not depend on the thread count: the work is cut into

@@ -16,7 +16,6 @@
 #include <memory>
 #include <mutex>
 #include <string_view>
-#include <thread>
 #include <type_traits>
 #include <vector>
 
