@@ -536,6 +536,12 @@ struct RepairLoop {
     if (opt.repair_at_cells) tm.at_fault = fault_places(tree, tm.oc.complex, tm.fe, bad2, tm.behind);
   }
 
+  /// May the octants on the surface still be refined for the topology (refine_surface_octants)?
+  bool surface_refinement_left(const TreeMesh& tm) const {
+    return topology_refinements < opt.topology_refinements &&
+           (!opt.surface_refinements_empty_only || tm.fe.mesh.solid.empty());
+  }
+
   /// True when the mesh's Euler characteristic is wrong and the octants on the surface were
   /// refined for it before the quality stage (refine_surface_octants).
   bool refine_for_topology_before_quality(TreeMesh& tm) {
@@ -547,8 +553,7 @@ struct RepairLoop {
     // are refined around, below). Measured (CLI, one thread, user s; the same mesh.msh on all 12
     // level-4 runs and the 6 level-5 tetrahedral ones): elephant L4 38.1 -> 31.7, anchor L4 7.8
     // -> 6.9.
-    if (!(tm.problems.empty() && !tm.folds_pending && topology_refinements < opt.topology_refinements && !tm.last))
-      return false;
+    if (!(tm.problems.empty() && !tm.folds_pending && surface_refinement_left(tm) && !tm.last)) return false;
     // The validator's checks without the surface's (on all threads: the same report).
     const auto validation = [&](const Mesh<3>& m) {
       ValidateOptions<3> vo;
@@ -765,17 +770,32 @@ struct RepairLoop {
   }
 
   /// Options3d::thickness_probe, once, after the run's first tree left problems: the thickness
-  /// try's first tree, with no repair; its mesh when it has no problem and validates. The
-  /// surface gets this try's levels back either way.
-  std::optional<Result3d> thickness_probe() {
+  /// try's first tree, with no repair; its mesh when it has no problem and validates. `empty`:
+  /// the first tree has no interior octant at all (the solid is thinner than the octants
+  /// everywhere): the thin retry's try instead (thin_retry_options, its repairs included), which
+  /// is not run again after the run's mesh (Effort::thin_early_refused) when refused. Measured
+  /// (a plate 2 x 2 x 0.05 with a hole, level 4, CLI, two threads): every try refined the
+  /// whole surface level by level, islands and folds, 55.7% of the volume lost after 19.6 s;
+  /// the thin retry's try alone: 612,398 tets, 28.40 deg, 1.71%, 2.8 s. The surface gets this
+  /// try's levels back either way.
+  std::optional<Result3d> thickness_probe(bool empty) {
     if (!std::exchange(first_of_run, false) || !opt.thickness_probe || opt.thickness_cells > 0 ||
-        !thickness_try_applies(s, opt))
+        !thickness_try_applies(s, opt) || (empty && !(opt.thin_retry_cells > 0)))
       return std::nullopt;
-    Options3d thick = thickness_try_options(opt);
-    thick.max_repairs = 0;
-    thick.first_round_inverted_share = 0.02;
-    say("the first tree has problems and the solid has thin parts: the first tree with " +
-        octants_across(thick.thickness_cells) + " them, without the buffer rule and without a repair");
+    Options3d thick;
+    if (empty) {
+      thick = thin_retry_options(opt, tree.n_leaves());
+      say("no interior octant and the solid is thin: the thin parts' try with " + octants_across(thick.thickness_cells) +
+          " them, without the buffer rule");
+    } else {
+      thick = thickness_try_options(opt);
+      thick.max_repairs = 0;
+      thick.first_round_inverted_share = 0.02;
+      say("the first tree has problems and the solid has thin parts: the first tree with " +
+          octants_across(thick.thickness_cells) + " them, without the buffer rule and without a repair");
+    }
+    const std::string what = empty ? "the thin parts' try" : "the first tree with the thickness level";
+    std::string& refused = empty ? effort.thin_early_refused : effort.thickness_probe_refused;
     std::optional<Result3d> stands;
     Effort own;
     try {
@@ -787,18 +807,17 @@ struct RepairLoop {
         times.insert(times.end(), t.times.begin(), t.times.end());
         t.times = std::move(times);
         stands = std::move(t);
-        say("thin parts: the first tree with the thickness level stands");
+        say("thin parts: " + what + " stands");
       } else {
-        effort.thickness_probe_refused = "not valid: " + v.summary();
-        say("thin parts: the first tree with the thickness level is not valid (" + v.summary() + "); going on");
+        refused = "not valid: " + v.summary();
+        say("thin parts: " + what + " is not valid (" + v.summary() + "); going on");
       }
     } catch (const GeometryError& e) {
-      effort.thickness_probe_refused = e.what();
-      say(std::string("thin parts: the first tree with the thickness level has problems (") + e.what() + "); going on");
+      refused = e.what();
+      say("thin parts: " + what + " has problems (" + e.what() + "); going on");
     } catch (const LimitError& e) {
-      effort.thickness_probe_refused = e.what();
-      say(std::string("thin parts: the first tree with the thickness level is over its bounds (") + e.what() +
-          "); going on");
+      refused = e.what();
+      say("thin parts: " + what + " is over its bounds (" + e.what() + "); going on");
     }
     effort.used += own.used;
     surface_levels();
@@ -817,12 +836,14 @@ struct RepairLoop {
       if (over_work_bound()) return restore_saved();
       build_boundary_octants(tm);
       if (tm.problems.empty()) make_tetrahedra(tm);
+      if (tm.problems.empty() && tm.fe.mesh.solid.empty())
+        if (std::optional<Result3d> thin = thickness_probe(true)) return std::move(*thin);
       if (refine_for_topology_before_quality(tm)) {
         first_of_run = false;  // the probe looks at the run's first tree only
         continue;
       }
       if (tm.problems.empty()) improve_and_check(tm);
-      if (tm.problems.empty() && topology_refinements < opt.topology_refinements && !tm.last) {
+      if (tm.problems.empty() && surface_refinement_left(tm) && !tm.last) {
         std::optional<long> euler;
         if (!tm.topology_right) euler = euler_characteristic<3>(tm.fe.mesh, opt.n_threads);
         if (refine_surface_octants(tm, true, euler)) {
@@ -831,7 +852,7 @@ struct RepairLoop {
         }
       }
       if (tm.problems.empty()) return finish(tm);
-      if (std::optional<Result3d> thick = thickness_probe()) return std::move(*thick);
+      if (std::optional<Result3d> thick = thickness_probe(false)) return std::move(*thick);
       if (peel_around_problems(tm)) continue;
       if (!refine_around_problems(tm)) return restore_saved();
     }

@@ -24,6 +24,10 @@ struct Effort {
   /// Why the probe did not stand, when it ran (Options3d::thickness_probe): the thickness try
   /// after a refusal would begin with the probe's tree again. Empty: no probe, or it stood.
   std::string thickness_probe_refused;
+  /// Why the thin parts' try at a first tree without an interior octant did not stand, when it
+  /// ran (Options3d::thickness_probe): the thin retry after the run's mesh would be that try
+  /// again. Empty: not run, or it stood.
+  std::string thin_early_refused;
   /// The run's tries at its level were refused (GeometryError) after building on fewer than
   /// Options3d::min_effort_octants octants: where a level raise (Options3d::raise_levels)
   /// applies, whether or not the run made it.

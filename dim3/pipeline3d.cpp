@@ -344,6 +344,27 @@ Result3d after_refusal(SurfaceBoundary& s, const Options3d& opt, const Effort& e
   throw E(reasons + "; without the feature level: " + why);
 }
 
+Options3d thin_retry_options(const Options3d& ran, std::size_t first_tree_leaves) {
+  Options3d thin = ran;
+  thin.thickness_cells = ran.thin_retry_cells;
+  thin.buffer = 0.0;
+  // No refinement of every octant on the surface for lost topology: on the thickness-refined
+  // tree it multiplies the octants (rotor L4: 37927 -> 116145 -> 311522 over the repairs, 2.5
+  // CPU minutes, refused), while its first tree's mesh may already lose less. Only while the
+  // tree has no interior octant: a plate 0.05 thick at level 4 (octants 0.13, the cap's 0.033)
+  // has none at the thickness level's cap, and one refinement more meshes it.
+  thin.surface_refinements_empty_only = true;
+  // A bounded retry: a few repairs per try, trees of at most 8x the first tree's octants (1M
+  // at least), and its own work bound of thin_retry_effort. Unbounded, rotor L5's retry ran for
+  // more than 17 CPU minutes without a mesh; past the bounds the first mesh stands.
+  thin.max_repairs = std::min(ran.max_repairs, 4);
+  thin.max_cells = std::min(ran.max_cells, std::max<std::size_t>(8 * first_tree_leaves, std::size_t{1} << 20));
+  thin.effort = std::min(ran.effort, ran.thin_retry_effort);
+  thin.min_effort_octants = 0;
+  thin.uniform_early_faceted = thin.uniform_early_snapped = false;  // a run's own chain only
+  return thin;
+}
+
 Options3d uniform_try_options(const Options3d& opt) {
   Options3d uniform = opt;
   uniform.extra_levels = 0;
@@ -439,24 +460,17 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
   // project through them (diagnose3d: spool L4 raw inverted tets 4167 with it, 1243 without).
   // Only here, so that the meshes that keep their volume stay bit for bit the same; the retry
   // stands only when it is valid and loses less.
-  Options3d thin = ran;
-  thin.thickness_cells = ran.thin_retry_cells;
-  thin.buffer = 0.0;
-  // No refinement of every octant on the surface for lost topology: on the thickness-refined
-  // tree it multiplies the octants (rotor L4: 37927 -> 116145 -> 311522 over the repairs, 2.5
-  // CPU minutes, refused), while its first tree's mesh may already lose less.
-  thin.topology_refinements = 0;
-  // A bounded retry: a few repairs per try, trees of at most 8x the first tree's octants (1M
-  // at least), and its own work bound of thin_retry_effort. Unbounded, rotor L5's retry ran for
-  // more than 17 CPU minutes without a mesh; past the bounds the first mesh stands.
-  thin.max_repairs = std::min(ran.max_repairs, 4);
-  thin.max_cells = std::min(ran.max_cells, std::max<std::size_t>(8 * r.tree.n_leaves(), std::size_t{1} << 20));
-  thin.effort = std::min(ran.effort, ran.thin_retry_effort);
-  thin.min_effort_octants = 0;
+  Options3d thin = thin_retry_options(ran, r.tree.n_leaves());
+  if (!effort.thin_early_refused.empty()) {
+    if (progress)
+      progress("volume error " + std::to_string(100 * error) + "%: not once more with " +
+               octants_across(thin.thickness_cells) + " the thin parts (refused at the first tree: " +
+               effort.thin_early_refused + ")");
+    return r;
+  }
   if (progress)
     progress("volume error " + std::to_string(100 * error) + "%: once more with " + octants_across(thin.thickness_cells) +
              " the thin parts, without the buffer rule");
-  thin.uniform_early_faceted = thin.uniform_early_snapped = false;  // a run's own chain only
   Effort thin_effort;
   try {
     Result3d t = mesh3d_tries(s, thin, thin_effort, progress);

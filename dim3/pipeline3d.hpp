@@ -154,6 +154,11 @@ struct Options3d {
   /// Refinements of the octants on the surface when thin parts fall apart (islands dropped or
   /// the wrong Euler characteristic).
   int topology_refinements = 2;
+  /// Those refinements only while the tree has no interior octant at all (the thin retry,
+  /// thin_retry_options: on a tree with interior octants they multiply the octants, rotor L4
+  /// 37,927 -> 116,145 -> 311,522 over the repairs; without any, a plate thinner than the
+  /// octants at the thickness level's cap has nothing to mesh).
+  bool surface_refinements_empty_only = false;
   /// Opt-in (0, the default: off). For a wrong Euler characteristic, refine only the octants on
   /// the surface within reach of the surface the BE mesh misses (dim3/missed_surface.hpp:
   /// samples farther from the interface triangles than this x the side of the octant they lie
@@ -444,6 +449,13 @@ Options3d facing_try_options(const Options3d& opt);
 /// (its one-octant slabs in thin parts project through them), no level raise, its own work
 /// bound of thin_retry_effort first trees.
 Options3d thickness_try_options(const Options3d& opt);
+
+/// The options of the thin retry (Options3d::thin_retry_cells octants across the thin parts,
+/// up to level + thickness_extra_levels) after a run at `ran` whose first tree had
+/// `first_tree_leaves` leaves: no buffer rule, the surface refined only while the tree has no
+/// interior octant (surface_refinements_empty_only), at most 4 repairs a try, trees of at most
+/// 8x the first tree's leaves (2^20 at least), its own work bound of thin_retry_effort.
+Options3d thin_retry_options(const Options3d& ran, std::size_t first_tree_leaves);
 
 /// The options of the try with the surface at one level (Options3d::uniform_after_refusal):
 /// extra_levels 0, no level raise, in_plane_cosine uniform_in_plane_cosine.
