@@ -19,6 +19,10 @@ struct Fidelity3d {
   double max_node_distance = 0.0;   ///< max distance of an interface node to the surface
 };
 
+/// How far the input surface gets from the BE mesh of `m` (its triangles): the largest distance
+/// of a surface vertex or triangle centroid to them (Fidelity3d::surface_to_be); 0 without any.
+double surface_to_be_distance(const Mesh<3>& m, const SurfaceBoundary& s);
+
 /// `samples` >= 1 sets the barycentric sampling density per BE triangle (samples per edge).
 Fidelity3d measure_fidelity(const Mesh<3>& m, const SurfaceBoundary& s, int samples = 4);
 

@@ -14,6 +14,7 @@
 #include "core/quality.hpp"
 #include "core/stage_timer.hpp"
 #include "core/validate.hpp"
+#include "dim3/fidelity3d.hpp"
 #include "dim3/mesh3d_try.hpp"
 #include "dim3/planar_frame.hpp"
 
@@ -452,24 +453,33 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
   ran.level += r.level_raised;
   if (!(ran.thin_retry_cells > 0) || ran.thickness_cells > 0 || r.thickness_early) return r;
   const double error = volume_error(r.fe.mesh, s, opt.n_threads);
-  if (!(error > ran.thin_retry_error)) return r;
+  // Or a thin part of little volume left out (Options3d::thin_retry_gap): how far the surface
+  // gets from the BE mesh, looked at only where part of the solid is thin.
+  const double side = s.octant_side(ran.level);
+  const bool by_volume = error > ran.thin_retry_error;
+  double gap = 0.0;
+  if (!by_volume && ran.thin_retry_gap > 0 && s.thin_share(ran.thin_retry_cells * side) > 0)
+    gap = surface_to_be_distance(r.fe.mesh, s);
+  if (!by_volume && !(gap > ran.thin_retry_gap * side)) return r;
+  const std::string why = by_volume ? "volume error " + std::to_string(100 * error) + "%"
+                                    : "the surface " + std::to_string(gap / side) + " octants from the BE mesh";
   // Parts thinner than the octants (rotor's blades, spool's flanges at level 4) have no
   // interior octant and are lost; the mesh is valid but misses them. Once more with the
   // thickness level (thin_retry_cells octants across every part, up to level +
   // thickness_extra_levels) and without the buffer rule, whose one-octant slabs in such parts
   // project through them (diagnose3d: spool L4 raw inverted tets 4167 with it, 1243 without).
-  // Only here, so that the meshes that keep their volume stay bit for bit the same; the retry
-  // stands only when it is valid and loses less.
+  // Only here, so that the meshes that keep their volume (and surface) stay bit for bit the
+  // same; the retry stands only when it is valid and loses less (for the gap: gets nearer).
   Options3d thin = thin_retry_options(ran, r.tree.n_leaves());
   if (!effort.thin_early_refused.empty()) {
     if (progress)
-      progress("volume error " + std::to_string(100 * error) + "%: not once more with " +
+      progress(why + ": not once more with " +
                octants_across(thin.thickness_cells) + " the thin parts (refused at the first tree: " +
                effort.thin_early_refused + ")");
     return r;
   }
   if (progress)
-    progress("volume error " + std::to_string(100 * error) + "%: once more with " + octants_across(thin.thickness_cells) +
+    progress(why + ": once more with " + octants_across(thin.thickness_cells) +
              " the thin parts, without the buffer rule");
   Effort thin_effort;
   try {
@@ -477,10 +487,12 @@ Result3d mesh3d_in_axes(SurfaceBoundary& s, const Options3d& opt, Effort& effort
     t.n_octants_built = r.n_octants_built + thin_effort.used;
     const ValidationReport& v = validation_of(t, s, opt.n_threads);
     const double t_error = volume_error(t.fe.mesh, s, opt.n_threads);
+    const double t_gap = by_volume || !v.valid ? 0.0 : surface_to_be_distance(t.fe.mesh, s);
     if (progress)
       progress("thin parts: the mesh is " + std::string(v.valid ? "valid" : "not valid (" + v.summary() + ")") +
-               ", volume error " + std::to_string(100 * t_error) + "%");
-    if (v.valid && t_error < error) {
+               ", volume error " + std::to_string(100 * t_error) + "%" +
+               (by_volume || !v.valid ? "" : ", the surface " + std::to_string(t_gap / side) + " octants from it"));
+    if (v.valid && (by_volume ? t_error < error : t_gap < gap && t_error <= std::max(error, ran.thin_retry_error))) {
       t.thickness_refined = true;
       t.level_raised = r.level_raised;
       std::vector<StageTime3> times = std::move(r.times);

@@ -520,6 +520,35 @@ TEST_CASE("mesh3d meshes a solid thinner than the octants everywhere by the thin
   if (!test::sanitized()) CHECK(tets[0] < tets[1]);
 }
 
+// Options3d::thin_retry_gap: a cone 2 high, r 0.4 (Gmsh, OpenCASCADE, 230 triangles) at level 5.
+// Its first mesh loses 4.17% of the volume, under the thin retry's 5%, but its tip is left out:
+// the surface gets 8.3 octants from the BE mesh. The retry for that gap stands (CLI in these
+// options, one thread: 16,727 -> 92,868 tets, 1.87 octants, 0.81% of the volume lost).
+TEST_CASE("mesh3d retries the thin parts where the surface gets far from the BE mesh", "[pipeline3d][thickness]") {
+  const std::string file = std::string(FEBEMESH_SOURCE_DIR) + "/tests/dim3/regressions/cone-h2-r0.4.off";
+  double gap[2] = {0.0, 0.0};
+  for (const bool retry : {true, false}) {
+    SurfaceBoundary s = SurfaceBoundary::from_file(file);
+    Options3d opt = in_own_axes(5);
+    if (!retry) opt.thin_retry_gap = 0.0;
+    std::vector<std::string> lines;
+    const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+    const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+    INFO("retry " << retry << ": " << v.summary());
+    CHECK(v.valid);
+    CHECK(r.thickness_refined == retry);
+    const bool said = std::any_of(lines.begin(), lines.end(), [](const std::string& m) {
+      return m.find("octants from the BE mesh: once more with 2 octants across the thin parts") != std::string::npos;
+    });
+    CHECK(said == retry);
+    const double error = std::abs(solid_measure<3>(r.fe.mesh) - s.volume()) / s.volume();
+    CHECK(error < opt.thin_retry_error);
+    gap[retry ? 0 : 1] = surface_to_be_distance(r.fe.mesh, s) / s.octant_side(opt.level);
+  }
+  CHECK(gap[0] < 2.0);
+  CHECK(gap[1] > 2.0);
+}
+
 // Options3d::skip_repeated_rounds on the voxel union of the island trial at level 4: in its first
 // try a round of the untangling's surface node moves puts every node back on its own point, and
 // the rounds after it are skipped. Off, they run: each prints the skipped round's summary again,
