@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <tuple>
 
 #include "core/error.hpp"
@@ -108,6 +109,26 @@ double SurfaceBoundary::thin_share(double h) {
     if (thick[t] < h) thin += a;
   }
   return all > 0 ? thin / all : 0.0;
+}
+
+double SurfaceBoundary::thin_parts_level(double cells, int level) {
+  const std::vector<double>& thick = thicknesses();
+  std::vector<std::pair<double, double>> levels;  // (level, area)
+  double all = 0.0;
+  for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) {
+    const double l = std::log2(root_side_ * cells / thick[t]);
+    if (!(std::isfinite(l) && l > level)) continue;
+    const Triangle& tr = surface_.triangle(t);
+    const double a = 0.5 * (surface_.vertex(tr[1]) - surface_.vertex(tr[0])).cross(surface_.vertex(tr[2]) - surface_.vertex(tr[0])).norm();
+    levels.emplace_back(l, a);
+    all += a;
+  }
+  if (levels.empty()) return -std::numeric_limits<double>::infinity();
+  std::sort(levels.begin(), levels.end());
+  double below = 0.0;
+  for (const auto& [l, a] : levels)
+    if ((below += a) >= 0.5 * all) return l;
+  return levels.back().first;
 }
 
 void SurfaceBoundary::set_thickness_level(double cells, double max_level) {

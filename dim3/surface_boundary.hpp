@@ -127,6 +127,10 @@ class SurfaceBoundary final : public Boundary<3> {
   const std::vector<double>& centroid_thicknesses();
   /// Share of the surface's area whose thickness (thickness(t)) is below `h`.
   double thin_share(double h);
+  /// The level whose octants put `cells` of them across the thin parts: the area-weighted
+  /// median, over the triangles thinner than `cells` octants of `level`, of log2(root side x
+  /// cells / thickness(t)); -infinity where none is.
+  double thin_parts_level(double cells, int level);
   double global_level() const { return options_.global_level; }
   double max_level() const { return options_.max_level; }
   /// Thickness of the solid behind triangle t: the smallest of the distances from its centroid
