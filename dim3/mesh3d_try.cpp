@@ -772,8 +772,8 @@ struct RepairLoop {
   /// Options3d::thickness_probe, once, after the run's first tree left problems: the thickness
   /// try's first tree, with no repair; its mesh when it has no problem and validates. `empty`:
   /// the first tree has no interior octant at all (the solid is thinner than the octants
-  /// everywhere): the thin retry's try instead (thin_retry_options, its repairs included), which
-  /// is not run again after the run's mesh (Effort::thin_early_refused) when refused. Measured
+  /// everywhere): the thin parts' try instead (thin_parts_try_options, its repairs included),
+  /// which is not run again after the run's mesh (Effort::thin_early_refused) when refused. Measured
   /// (a plate 2 x 2 x 0.05 with a hole, level 4, CLI, two threads): every try refined the
   /// whole surface level by level, islands and folds, 55.7% of the volume lost after 19.6 s;
   /// the thin retry's try alone: 612,398 tets, 28.40 deg, 1.71%, 2.8 s. The surface gets this
@@ -784,22 +784,7 @@ struct RepairLoop {
       return std::nullopt;
     Options3d thick;
     if (empty) {
-      thick = thin_retry_options(opt, tree.n_leaves());
-      // The cap of the thickness level where the thin parts need more than level + 2 for their
-      // octants across (at most 4 levels more; the try's bounds refuse a tree too large).
-      // Measured (a ring r 1, 0.03 thick, 0.3 high, CLI, one thread): refused at levels 4 and
-      // 5 with the cap at level + 2 (about one octant across, folds); the try alone with level 8
-      // (diagnose3d --thickness-extra 4): valid at level 4, 1,603,728 tets, 17.89 deg, 36 s.
-      const double needed = std::ceil(s.thin_parts_level(thick.thickness_cells, opt.level));
-      if (std::isfinite(needed))
-        thick.thickness_extra_levels = std::clamp(static_cast<int>(needed) - opt.level, opt.thickness_extra_levels,
-                                                  opt.thickness_extra_levels + 4);
-      // Two levels of repairs below the thin parts' octants (else max(level + extra_levels,
-      // the cap): none at the cap), and the run's least work bound (the retry has none: it
-      // only improves a mesh; here it is the run's try).
-      if (opt.max_level < 0)
-        thick.max_level = std::max(opt.level + opt.extra_levels, opt.level + thick.thickness_extra_levels) + 2;
-      thick.min_effort_octants = opt.min_effort_octants;
+      thick = thin_parts_try_options(s, opt, tree.n_leaves());
       say("no interior octant and the solid is thin: the thin parts' try with " + octants_across(thick.thickness_cells) +
           " them, without the buffer rule");
     } else {

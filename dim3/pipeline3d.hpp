@@ -469,6 +469,13 @@ Options3d thickness_try_options(const Options3d& opt);
 /// 8x the first tree's leaves (2^20 at least), its own work bound of thin_retry_effort.
 Options3d thin_retry_options(const Options3d& ran, std::size_t first_tree_leaves);
 
+/// The options of the thin parts' try at a first tree without an interior octant
+/// (Options3d::thickness_probe): thin_retry_options, with the thickness level's cap at the level
+/// that puts thin_retry_cells octants across the thin parts (SurfaceBoundary::thin_parts_level;
+/// level + thickness_extra_levels at least, 4 levels more at most), two levels of repairs below
+/// it, and the run's min_effort_octants.
+Options3d thin_parts_try_options(SurfaceBoundary& s, const Options3d& opt, std::size_t first_tree_leaves);
+
 /// The options of the try with the surface at one level (Options3d::uniform_after_refusal):
 /// extra_levels 0, no level raise, in_plane_cosine uniform_in_plane_cosine.
 Options3d uniform_try_options(const Options3d& opt);
