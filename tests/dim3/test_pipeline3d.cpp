@@ -73,6 +73,20 @@ Options3d in_own_axes(int level) {
   return opt;
 }
 
+/// mesh3d of `s` at `level` in its own axes (in_own_axes) with Options3d::thickness_probe on or
+/// off, its progress lines into `lines`; checks that the mesh is valid and stood at the probe
+/// exactly when the probe is on.
+Result3d probe_run(SurfaceBoundary& s, int level, bool probe, std::vector<std::string>& lines) {
+  Options3d opt = in_own_axes(level);
+  opt.thickness_probe = probe;
+  Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
+  const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
+  INFO("probe " << probe << ": " << v.summary());
+  CHECK(v.valid);
+  CHECK(r.thickness_early == probe);
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("sphere966 at level 4 gives a valid mesh close to the sphere's volume", "[pipeline3d]") {
@@ -420,14 +434,8 @@ TEST_CASE("mesh3d's thickness probe stands where the first tree has problems at 
   double error[2] = {1.0, 1.0};
   for (const bool probe : probes) {
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
-    Options3d opt = in_own_axes(3);
-    opt.thickness_probe = probe;
     std::vector<std::string> lines;
-    const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
-    const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
-    INFO("probe " << probe << ": " << v.summary());
-    CHECK(v.valid);
-    CHECK(r.thickness_early == probe);
+    const Result3d r = probe_run(s, 3, probe, lines);
     CHECK(r.thickness_refined == !probe);
     const bool probed = std::any_of(lines.begin(), lines.end(), [](const std::string& m) {
       return m.find("the first tree with the thickness level stands") != std::string::npos;
@@ -501,14 +509,8 @@ TEST_CASE("mesh3d meshes a solid thinner than the octants everywhere by the thin
   std::size_t tets[2] = {0, 0};
   for (const bool probe : probes) {
     SurfaceBoundary s = SurfaceBoundary::from_file(file);
-    Options3d opt = in_own_axes(4);
-    opt.thickness_probe = probe;
     std::vector<std::string> lines;
-    const Result3d r = mesh3d(s, opt, [&](const std::string& m) { lines.push_back(m); });
-    const ValidationReport v = validate(r.fe.mesh, surface_validation(s));
-    INFO("probe " << probe << ": " << v.summary());
-    CHECK(v.valid);
-    CHECK(r.thickness_early == probe);
+    const Result3d r = probe_run(s, 4, probe, lines);
     CHECK(r.level_raised == 0);
     const auto said = [&](const std::string& text) {
       return std::any_of(lines.begin(), lines.end(), [&](const std::string& m) { return m.find(text) != std::string::npos; });
