@@ -103,8 +103,7 @@ double SurfaceBoundary::thin_share(double h) {
   const std::vector<double>& thick = thicknesses();
   double thin = 0.0, all = 0.0;
   for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) {
-    const Triangle& tr = surface_.triangle(t);
-    const double a = 0.5 * (surface_.vertex(tr[1]) - surface_.vertex(tr[0])).cross(surface_.vertex(tr[2]) - surface_.vertex(tr[0])).norm();
+    const double a = surface_.triangle_area(t);
     all += a;
     if (thick[t] < h) thin += a;
   }
@@ -118,8 +117,7 @@ double SurfaceBoundary::thin_parts_level(double cells, int level) {
   for (std::int32_t t = 0; t < surface_.n_triangles(); ++t) {
     const double l = std::log2(root_side_ * cells / thick[t]);
     if (!(std::isfinite(l) && l > level)) continue;
-    const Triangle& tr = surface_.triangle(t);
-    const double a = 0.5 * (surface_.vertex(tr[1]) - surface_.vertex(tr[0])).cross(surface_.vertex(tr[2]) - surface_.vertex(tr[0])).norm();
+    const double a = surface_.triangle_area(t);
     levels.emplace_back(l, a);
     all += a;
   }
